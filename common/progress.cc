@@ -1,0 +1,64 @@
+#include "common/progress.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+namespace hexbite {
+
+namespace {
+bool g_quiet = false;
+}
+
+void set_quiet(bool quiet) { g_quiet = quiet; }
+bool is_quiet() { return g_quiet; }
+
+void info(const std::string& line) {
+  if (!g_quiet) std::cout << line << '\n';
+}
+
+Progress::Progress(std::string label)
+    : label_(std::move(label)),
+      active_(!g_quiet && ::isatty(STDERR_FILENO)),
+      start_(std::chrono::steady_clock::now()),
+      last_draw_(start_) {
+  if (active_) draw(0.0, "", false);
+}
+
+Progress::~Progress() {
+  if (!finished_) finish();
+}
+
+double Progress::seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void Progress::update(double fraction, const std::string& note) {
+  if (!active_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_draw_ < std::chrono::milliseconds(100)) return;
+  last_draw_ = now;
+  draw(fraction, note, false);
+}
+
+void Progress::finish(const std::string& note) {
+  if (finished_) return;
+  finished_ = true;
+  if (active_) draw(1.0, note, true);
+}
+
+void Progress::draw(double fraction, const std::string& note, bool final_line) {
+  constexpr int kWidth = 24;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const int filled = static_cast<int>(fraction * kWidth + 0.5);
+  std::string bar(filled, '#');
+  bar.append(kWidth - filled, ' ');
+  std::fprintf(stderr, "\r\033[K%-28s [%s] %3d%%  %6.1f s  %s", label_.c_str(), bar.c_str(),
+               static_cast<int>(fraction * 100 + 0.5), seconds(), note.c_str());
+  if (final_line) std::fputc('\n', stderr);
+  std::fflush(stderr);
+}
+
+}  // namespace hexbite

@@ -1,0 +1,41 @@
+// Progress display for long steps: a self-updating line on a terminal, nothing when quiet or piped.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace hexbite {
+
+// Global verbosity of the command line program; set once from --quiet.
+void set_quiet(bool quiet);
+bool is_quiet();
+
+// Prints an informational line to stdout unless quiet.
+void info(const std::string& line);
+
+// A progress bar for one named step. On a terminal (stderr is a TTY) it redraws
+// "label  [#####     ]  45%  3.2 s" at most every 0.1 s; otherwise it stays silent.
+// finish() (or the destructor) prints the step's total time on a terminal.
+class Progress {
+ public:
+  explicit Progress(std::string label);
+  ~Progress();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  // fraction in [0, 1]; an optional short note (e.g. "pass 3") is shown after the bar.
+  void update(double fraction, const std::string& note = "");
+  void finish(const std::string& note = "");
+  double seconds() const;
+
+ private:
+  void draw(double fraction, const std::string& note, bool final_line);
+
+  std::string label_;
+  bool active_;
+  bool finished_ = false;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_;
+};
+
+}  // namespace hexbite

@@ -1,0 +1,83 @@
+#include "tests/test_util.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace hexbite::test {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) {
+    if (c == '\'')
+      q += "'\\''";
+    else
+      q += c;
+  }
+  return q + "'";
+}
+
+struct TempRoot {
+  fs::path path;
+  TempRoot() {
+    std::string templ = (fs::temp_directory_path() / "hexbite-test-XXXXXX").string();
+    path = ::mkdtemp(templ.data());
+  }
+  ~TempRoot() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+}  // namespace
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_file(const std::string& path, const std::string& contents) {
+  std::ofstream out(path, std::ios::binary);
+  out << contents;
+}
+
+std::string temp_dir() {
+  static TempRoot root;
+  static int counter = 0;
+  fs::path dir = root.path / std::to_string(counter++);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+CommandResult run_hexbite(const std::vector<std::string>& args) {
+  const std::string dir = temp_dir();
+  const std::string out_file = dir + "/stdout", err_file = dir + "/stderr";
+  std::string cmd = shell_quote(HEXBITE_EXE);
+  for (const auto& a : args) cmd += " " + shell_quote(a);
+  cmd += " >" + shell_quote(out_file) + " 2>" + shell_quote(err_file) + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CommandResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_file(out_file);
+  r.err = read_file(err_file);
+  return r;
+}
+
+std::string shared_data(const std::string& relative) {
+  const std::string path = std::string(HEXBITE_SHARED_DATA) + "/" + relative;
+  if (!fs::exists(path)) ADD_FAILURE() << "shared test data missing: " << path;
+  return path;
+}
+
+}  // namespace hexbite::test

@@ -1,0 +1,28 @@
+// Helpers shared by the test suites: running the hexbite program, temporary folders, shared data.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace hexbite::test {
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// Runs the built hexbite program with the given arguments (no shell quoting needed).
+CommandResult run_hexbite(const std::vector<std::string>& args);
+
+// A fresh, empty temporary folder per call, removed at process exit.
+std::string temp_dir();
+
+// Path of a file under ../shared/data; fails the current test if it is missing.
+std::string shared_data(const std::string& relative);
+
+// Reads or writes a whole file.
+std::string read_file(const std::string& path);
+void write_file(const std::string& path, const std::string& contents);
+
+}  // namespace hexbite::test
