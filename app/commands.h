@@ -12,5 +12,6 @@ void add_surface_check_command(CLI::App& surface);
 void add_surface_clean_command(CLI::App& surface);
 void add_surface_from_ct_command(CLI::App& surface);
 void add_generate_commands(CLI::App& app);  // generate mandible
+void add_quality_command(CLI::App& app);    // quality MESH.vtu
 
 }  // namespace hexbite

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
 
   hexbite::add_surface_commands(app);
   hexbite::add_generate_commands(app);
+  hexbite::add_quality_command(app);
 
   try {
     app.parse(argc, argv);
