@@ -1,9 +1,151 @@
+// `hexbite generate mandible`: the built-in CT-like mandible with its landmark file and, on request,
+// the CT-like volume it was extracted from.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
 
 #include "app/commands.h"
+#include "common/error.h"
+#include "common/progress.h"
+#include "mesher/ct_surface.h"
+#include "mesher/landmarks.h"
+#include "mesher/mandible_generator.h"
+#include "mesher/surface_io.h"
 
 namespace hexbite {
 
-void add_generate_commands(CLI::App& app) { (void)app; }
+namespace {
+
+namespace fs = std::filesystem;
+
+struct GenerateArgs {
+  std::string output, landmarks, ct, variant = "dentate";
+  MandibleParameters parameters;
+};
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+bool has_suffix(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// Every output is checked before the (short) generation so that a mistake in one of them never
+// leaves the others written.
+void check_output(const std::string& path, const std::vector<std::string>& extensions, const char* what) {
+  const std::string l = lower(path);
+  if (std::none_of(extensions.begin(), extensions.end(),
+                   [&](const std::string& e) { return has_suffix(l, e); })) {
+    std::string list;
+    for (const auto& e : extensions) list += (list.empty() ? "" : ", ") + e;
+    throw InputError("cannot write " + std::string(what) + " '" + path + "': use one of " + list);
+  }
+  const fs::path dir = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+  if (!fs::is_directory(dir))
+    throw InputError("cannot write '" + path + "': directory '" + dir.string() +
+                     "' does not exist; create it first");
+}
+
+std::string default_landmark_path(const std::string& surface_path) {
+  fs::path p(surface_path);
+  return (p.parent_path() / (p.stem().string() + ".landmarks.yaml")).string();
+}
+
+double enclosed_volume(const TriSurface& s) {
+  double six = 0;
+  for (const auto& t : s.triangles) {
+    const Vec3& a = s.vertices[t[0]];
+    const Vec3& b = s.vertices[t[1]];
+    const Vec3& c = s.vertices[t[2]];
+    six += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return six / 6.0;
+}
+
+void run_generate(const GenerateArgs& args) {
+  MandibleParameters params = args.parameters;
+  params.variant = parse_variant(args.variant);
+  params = complete_parameters(params);
+  const std::string landmark_path =
+      args.landmarks.empty() ? default_landmark_path(args.output) : args.landmarks;
+  check_output(args.output, {".stl", ".obj", ".ply", ".off", ".vtp"}, "surface");
+  check_output(landmark_path, {".yaml", ".yml"}, "landmarks");
+  if (!args.ct.empty()) check_output(args.ct, {".mha", ".mhd", ".nii", ".nii.gz"}, "CT volume");
+
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress("generate mandible");
+  const GeneratedMandible jaw = generate_mandible(params);
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  write_surface(args.output, jaw.surface);
+  write_landmarks(landmark_path, jaw.landmarks, mandible_landmark_header(params));
+  if (!args.ct.empty()) write_volume(args.ct, jaw.ct);
+
+  Vec3 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+          std::numeric_limits<double>::max()};
+  Vec3 hi{-lo[0], -lo[1], -lo[2]};
+  for (const auto& v : jaw.surface.vertices)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], v[k]);
+      hi[k] = std::max(hi[k], v[k]);
+    }
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "mandible (%s): %zu triangles, %zu vertices", variant_name(params.variant),
+                jaw.surface.triangles.size(), jaw.surface.vertices.size());
+  info(buf);
+  std::snprintf(buf, sizeof buf,
+                "  bounding box %.1f x %.1f x %.1f mm, from (%.1f, %.1f, %.1f) to (%.1f, %.1f, %.1f)",
+                hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+  info(buf);
+  std::snprintf(buf, sizeof buf, "  volume %.1f cm^3", enclosed_volume(jaw.surface) / 1000.0);
+  info(buf);
+  std::snprintf(
+      buf, sizeof buf,
+      "  dimensions: arch width %g, arch depth %g, body height %g, body thickness %g, ramus height %g, "
+      "ramus width %g mm, gonial angle %g deg",
+      params.arch_width_mm, params.arch_depth_mm, params.body_height_mm, params.body_thickness_mm,
+      params.ramus_height_mm, params.ramus_width_mm, params.gonial_angle_deg);
+  info(buf);
+  std::snprintf(buf, sizeof buf, "  CT grid %d x %d x %d voxels of %g mm, threshold %g HU; %.2f s",
+                jaw.ct.dims[0], jaw.ct.dims[1], jaw.ct.dims[2], jaw.ct.spacing, jaw.threshold, seconds);
+  info(buf);
+  info("wrote " + args.output + ", " + landmark_path + (args.ct.empty() ? "" : ", " + args.ct));
+}
+
+}  // namespace
+
+void add_generate_commands(CLI::App& app) {
+  CLI::App* generate = app.add_subcommand("generate", "Generate built-in input geometry");
+  generate->require_subcommand(1);
+  CLI::App* cmd = generate->add_subcommand(
+      "mandible", "The built-in CT-like adult mandible: surface (marching cubes), landmarks and CT volume");
+  auto args = std::make_shared<GenerateArgs>();
+  MandibleParameters& p = args->parameters;
+  cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")->required();
+  cmd->add_option("--landmarks", args->landmarks,
+                  "Landmark and muscle file to write (YAML); default: OUTPUT's name with .landmarks.yaml");
+  cmd->add_option("--ct", args->ct, "Also write the CT-like volume (.mha, .mhd, .nii, .nii.gz)");
+  cmd->add_option("--variant", args->variant, "dentate, edentulous or atrophic (resorbed, low body)");
+  cmd->add_option("--voxel", p.voxel_mm, "Voxel size of the CT-like grid in mm (0.25 to 1.5)");
+  const char* zero = " (default: the variant's, see docs/mandible.md)";
+  cmd->add_option("--arch-width", p.arch_width_mm, std::string("Bigonial width in mm") + zero);
+  cmd->add_option("--arch-depth", p.arch_depth_mm, std::string("Symphysis to gonion along y in mm") + zero);
+  cmd->add_option("--body-height", p.body_height_mm,
+                  std::string("Body height at the first molar in mm") + zero);
+  cmd->add_option("--body-thickness", p.body_thickness_mm,
+                  std::string("Body thickness at the first molar in mm") + zero);
+  cmd->add_option("--ramus-height", p.ramus_height_mm, std::string("Gonion to condylion in mm") + zero);
+  cmd->add_option("--ramus-width", p.ramus_width_mm, std::string("Minimum ramus breadth in mm") + zero);
+  cmd->add_option("--gonial-angle", p.gonial_angle_deg, std::string("Gonial angle in degrees") + zero);
+  cmd->callback([args] { run_generate(*args); });
+}
 
 }  // namespace hexbite

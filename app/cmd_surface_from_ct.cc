@@ -1,9 +1,71 @@
+// `hexbite surface from-ct`: the iso-surface of a CT volume, the first step of the seed paper's pipeline.
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
 
 #include "app/commands.h"
+#include "common/error.h"
+#include "common/progress.h"
+#include "mesher/ct_surface.h"
+#include "mesher/surface_io.h"
 
 namespace hexbite {
 
-void add_surface_from_ct_command(CLI::App& surface) { (void)surface; }
+namespace {
+
+struct FromCtArgs {
+  std::string volume, output;
+  double threshold = 0;
+};
+
+void run_from_ct(const FromCtArgs& args) {
+  // The output folder is checked first: a long extraction should not end in "cannot write".
+  const std::filesystem::path out(args.output);
+  const auto dir = out.has_parent_path() ? out.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(dir))
+    throw InputError("cannot write '" + args.output + "': directory '" + dir.string() +
+                     "' does not exist; create it first");
+
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress("extract surface");
+  const VoxelVolume volume = read_volume(args.volume);
+  const TriSurface surface = surface_from_volume(volume, args.threshold);
+  progress.finish();
+  write_surface(args.output, surface);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  double six_volume = 0;
+  for (const auto& t : surface.triangles) {
+    const Vec3& a = surface.vertices[t[0]];
+    const Vec3& b = surface.vertices[t[1]];
+    const Vec3& c = surface.vertices[t[2]];
+    six_volume += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                  a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  const Vec3 h = volume.spacing_xyz();
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "volume %d x %d x %d voxels of %g x %g x %g mm, threshold %g",
+                volume.dims[0], volume.dims[1], volume.dims[2], h[0], h[1], h[2], args.threshold);
+  info(buf);
+  std::snprintf(buf, sizeof buf, "surface: %zu triangles, %zu vertices, enclosed volume %.1f cm^3; %.2f s",
+                surface.triangles.size(), surface.vertices.size(), six_volume / 6000.0, seconds);
+  info(buf);
+  info("wrote " + args.output);
+}
+
+}  // namespace
+
+void add_surface_from_ct_command(CLI::App& surface) {
+  CLI::App* cmd = surface.add_subcommand(
+      "from-ct", "Extract the bone surface from a CT volume (MetaImage .mha/.mhd or NIfTI .nii/.nii.gz)");
+  auto args = std::make_shared<FromCtArgs>();
+  cmd->add_option("VOLUME", args->volume, "CT volume file")->required();
+  cmd->add_option("--threshold", args->threshold,
+                  "Iso-value in the volume's units (e.g. Hounsfield units; the built-in mandible uses 620)")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")->required();
+  cmd->callback([args] { run_from_ct(*args); });
+}
 
 }  // namespace hexbite

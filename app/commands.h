@@ -13,5 +13,9 @@ void add_surface_clean_command(CLI::App& surface);
 void add_surface_from_ct_command(CLI::App& surface);
 void add_generate_commands(CLI::App& app);  // generate mandible
 void add_quality_command(CLI::App& app);    // quality MESH.vtu
+void add_render_command(CLI::App& app);     // render INPUT -o PNG
+void add_mesh_command(CLI::App& app);       // mesh SURFACE --method grid, cmd_mesh.cc
+void add_refine_command(CLI::App& app);     // refine MESH.vtu --surface SURFACE -o fine.vtu, cmd_refine.cc
+void add_reorder_command(CLI::App& app);    // reorder MESH.vtu -o out.vtu --method bfs|rcm, cmd_reorder.cc
 
 }  // namespace hexbite

@@ -24,6 +24,10 @@ int main(int argc, char** argv) {
   hexbite::add_surface_commands(app);
   hexbite::add_generate_commands(app);
   hexbite::add_quality_command(app);
+  hexbite::add_render_command(app);
+  hexbite::add_mesh_command(app);
+  hexbite::add_refine_command(app);
+  hexbite::add_reorder_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,353 @@
+#include "mesher/ct_surface.h"
+
+#include <unistd.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCellArray.h>
+#include <vtkCleanPolyData.h>
+#include <vtkDataArray.h>
+#include <vtkFloatArray.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkMetaImageReader.h>
+#include <vtkMetaImageWriter.h>
+#include <vtkNIFTIImageReader.h>
+#include <vtkNIFTIImageWriter.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataConnectivityFilter.h>
+#include <vtkSmartPointer.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "common/error.h"
+
+namespace hexbite {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+enum class VolumeFormat { kMetaImage, kNifti };
+
+// The full extension decides the format; ".nii.gz" has two parts, so the stem alone is not enough.
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+struct FormatAndExtension {
+  VolumeFormat format;
+  std::string extension;  // as written in the path, e.g. ".nii.gz"
+};
+
+FormatAndExtension volume_format(const std::string& path) {
+  std::string lower = path;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  for (const char* ext : {".mha", ".mhd"})
+    if (ends_with(lower, ext)) return {VolumeFormat::kMetaImage, path.substr(path.size() - 4)};
+  if (ends_with(lower, ".nii.gz")) return {VolumeFormat::kNifti, path.substr(path.size() - 7)};
+  if (ends_with(lower, ".nii")) return {VolumeFormat::kNifti, path.substr(path.size() - 4)};
+  throw InputError("'" + path +
+                   "': unknown volume format; use MetaImage (.mha, .mhd) or NIfTI (.nii, .nii.gz)");
+}
+
+// VTK reports reader failures through its output window; an observer keeps the message so that
+// it can become part of our own error (naming the file) instead of a stray line on stderr.
+struct ErrorCatcher {
+  std::string message;
+  vtkSmartPointer<vtkCallbackCommand> command = vtkSmartPointer<vtkCallbackCommand>::New();
+  ErrorCatcher() {
+    command->SetClientData(this);
+    command->SetCallback([](vtkObject*, unsigned long, void* client, void* call) {
+      auto* self = static_cast<ErrorCatcher*>(client);
+      if (self->message.empty() && call) self->message = static_cast<const char*>(call);
+    });
+  }
+  void watch(vtkObject* object) {
+    object->AddObserver(vtkCommand::ErrorEvent, command);
+    object->AddObserver(vtkCommand::WarningEvent, command);
+  }
+};
+
+std::string first_line(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  const auto nl = s.rfind('\n');
+  return nl == std::string::npos ? s : s.substr(nl + 1);
+}
+
+vtkSmartPointer<vtkImageData> to_image(const VoxelVolume& volume, int pad, float pad_value) {
+  const auto& d = volume.dims;
+  const Vec3 h = volume.spacing_xyz();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  const int n[3] = {d[0] + 2 * pad, d[1] + 2 * pad, d[2] + 2 * pad};
+  image->SetDimensions(n);
+  image->SetSpacing(h[0], h[1], h[2]);
+  image->SetOrigin(volume.origin[0] - pad * h[0], volume.origin[1] - pad * h[1],
+                   volume.origin[2] - pad * h[2]);
+  auto values = vtkSmartPointer<vtkFloatArray>::New();
+  values->SetName("HU");
+  values->SetNumberOfTuples(static_cast<vtkIdType>(n[0]) * n[1] * n[2]);
+  float* out = values->GetPointer(0);
+  std::fill(out, out + values->GetNumberOfTuples(), pad_value);
+  for (int k = 0; k < d[2]; ++k)
+    for (int j = 0; j < d[1]; ++j) {
+      const float* src = volume.values.data() + (static_cast<std::size_t>(k) * d[1] + j) * d[0];
+      float* dst = out + (static_cast<std::size_t>(k + pad) * n[1] + (j + pad)) * n[0] + pad;
+      std::copy(src, src + d[0], dst);
+    }
+  image->GetPointData()->SetScalars(values);
+  return image;
+}
+
+void check_volume(const VoxelVolume& volume) {
+  const auto& d = volume.dims;
+  if (d[0] < 1 || d[1] < 1 || d[2] < 1)
+    throw InputError("the volume is empty (dimensions " + std::to_string(d[0]) + " x " +
+                     std::to_string(d[1]) + " x " + std::to_string(d[2]) + ")");
+  if (volume.values.size() != static_cast<std::size_t>(d[0]) * d[1] * d[2])
+    throw InputError("the volume holds " + std::to_string(volume.values.size()) +
+                     " values, its dimensions need " +
+                     std::to_string(static_cast<std::size_t>(d[0]) * d[1] * d[2]));
+  const Vec3 h = volume.spacing_xyz();
+  for (double s : h)
+    if (!(s > 0) || !std::isfinite(s)) throw InputError("the volume's voxel spacing must be positive");
+}
+
+// Reverses the voxel order along `axis` (used for NIfTI orientations that point an axis backwards).
+void flip_axis(VoxelVolume& v, int axis) {
+  const auto& d = v.dims;
+  for (int k = 0; k < d[2]; ++k)
+    for (int j = 0; j < d[1]; ++j)
+      for (int i = 0; i < d[0]; ++i) {
+        int idx[3] = {i, j, k};
+        if (idx[axis] >= d[axis] / 2) continue;
+        int mirror[3] = {i, j, k};
+        mirror[axis] = d[axis] - 1 - idx[axis];
+        std::swap(v.values[(static_cast<std::size_t>(k) * d[1] + j) * d[0] + i],
+                  v.values[(static_cast<std::size_t>(mirror[2]) * d[1] + mirror[1]) * d[0] + mirror[0]]);
+      }
+}
+
+}  // namespace
+
+VoxelVolume read_volume(const std::string& path) {
+  if (!fs::exists(path)) throw InputError("volume file '" + path + "' does not exist");
+  const FormatAndExtension fmt = volume_format(path);
+  if (fs::is_directory(path)) throw InputError("'" + path + "' is a folder, not a volume file");
+
+  ErrorCatcher errors;
+  vtkSmartPointer<vtkImageData> image;
+  vtkSmartPointer<vtkMatrix4x4> orientation;
+  double slope = 1, intercept = 0;
+  if (fmt.format == VolumeFormat::kMetaImage) {
+    auto reader = vtkSmartPointer<vtkMetaImageReader>::New();
+    errors.watch(reader);
+    if (!reader->CanReadFile(path.c_str()))
+      throw InputError("'" + path + "' is not a readable MetaImage file (header missing or malformed)");
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    image = reader->GetOutput();
+  } else {
+    auto reader = vtkSmartPointer<vtkNIFTIImageReader>::New();
+    errors.watch(reader);
+    if (!reader->CanReadFile(path.c_str()))
+      throw InputError("'" + path + "' is not a readable NIfTI file (header missing or malformed)");
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    image = reader->GetOutput();
+    // NIfTI stores the grid's placement in the qform (preferred, rigid) or sform matrix; VTK leaves
+    // the image origin at zero and hands the matrix over separately.
+    orientation = reader->GetQFormMatrix() ? reader->GetQFormMatrix() : reader->GetSFormMatrix();
+    if (reader->GetRescaleSlope() != 0) {
+      slope = reader->GetRescaleSlope();
+      intercept = reader->GetRescaleIntercept();
+    }
+  }
+  if (!errors.message.empty() || !image || !image->GetPointData()->GetScalars())
+    throw InputError("cannot read volume '" + path + "'" +
+                     (errors.message.empty() ? std::string() : ": " + first_line(errors.message)));
+  vtkDataArray* scalars = image->GetPointData()->GetScalars();
+  if (scalars->GetNumberOfComponents() != 1)
+    throw InputError("volume '" + path + "' has " + std::to_string(scalars->GetNumberOfComponents()) +
+                     " components per voxel; a CT volume has one");
+
+  VoxelVolume v;
+  int dims[3];
+  image->GetDimensions(dims);
+  v.dims = {dims[0], dims[1], dims[2]};
+  const double* sp = image->GetSpacing();
+  const double* org = image->GetOrigin();
+  v.origin = {org[0], org[1], org[2]};
+  v.axis_spacing = {std::abs(sp[0]), std::abs(sp[1]), std::abs(sp[2])};
+  v.spacing = v.axis_spacing[0];
+  const vtkIdType n = scalars->GetNumberOfTuples();
+  if (n != static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2] || n == 0)
+    throw InputError("volume '" + path + "' holds no voxels or fewer than its header announces");
+  v.values.resize(static_cast<std::size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i) {
+    const double value = scalars->GetComponent(i, 0) * slope + intercept;
+    v.values[static_cast<std::size_t>(i)] = static_cast<float>(value);
+  }
+
+  if (orientation) {
+    // Axis-aligned placements (possibly with reversed axes) are turned into a plain origin;
+    // a rotated grid would need resampling, which is the job of a dedicated imaging tool.
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        const double m = orientation->GetElement(r, c);
+        if (r != c && std::abs(m) > 1e-6)
+          throw InputError("volume '" + path +
+                           "' is stored in a rotated orientation; resample it to an axis-aligned grid first");
+        if (r == c && std::abs(std::abs(m) - 1) > 1e-6)
+          throw InputError("volume '" + path + "' has a scaled orientation matrix; it is not supported");
+      }
+    for (int a = 0; a < 3; ++a) {
+      const double t = orientation->GetElement(a, 3) + orientation->GetElement(a, a) * org[a];
+      if (orientation->GetElement(a, a) < 0) {
+        flip_axis(v, a);
+        v.origin[a] = t - (v.dims[a] - 1) * v.axis_spacing[a];
+      } else {
+        v.origin[a] = t;
+      }
+    }
+  }
+  if (std::abs(v.axis_spacing[1] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0] &&
+      std::abs(v.axis_spacing[2] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0])
+    v.axis_spacing = {};
+  return v;
+}
+
+void write_volume(const std::string& path, const VoxelVolume& volume) {
+  const FormatAndExtension fmt = volume_format(path);
+  check_volume(volume);
+  const fs::path target(path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir))
+    throw InputError("cannot write '" + path + "': directory '" + dir.string() +
+                     "' does not exist; create it first");
+  // The temporary name keeps the whole extension (".nii.gz"), from which the VTK writers choose
+  // the format and the compression.
+  const std::string base = target.filename().string();
+  const std::string stem = base.substr(0, base.size() - fmt.extension.size());
+  const fs::path tmp = dir / ("." + stem + ".tmp" + std::to_string(::getpid()) + fmt.extension);
+  // A .mhd header refers to a separate data file, written straight to its final name beside it.
+  const fs::path raw = dir / (stem + ".zraw");
+
+  auto image = to_image(volume, 0, 0.0f);
+  ErrorCatcher errors;
+  if (fmt.format == VolumeFormat::kMetaImage) {
+    auto writer = vtkSmartPointer<vtkMetaImageWriter>::New();
+    errors.watch(writer);
+    writer->SetInputData(image);
+    writer->SetCompression(true);
+    writer->SetFileName(tmp.c_str());
+    if (fmt.extension != ".mha" && fmt.extension != ".MHA") writer->SetRAWFileName(raw.c_str());
+    writer->Write();
+  } else {
+    // The grid's placement goes into the qform; VTK's NIfTI writer ignores the image origin.
+    auto qform = vtkSmartPointer<vtkMatrix4x4>::New();
+    for (int a = 0; a < 3; ++a) qform->SetElement(a, 3, volume.origin[a]);
+    image->SetOrigin(0, 0, 0);
+    auto writer = vtkSmartPointer<vtkNIFTIImageWriter>::New();
+    errors.watch(writer);
+    writer->SetInputData(image);
+    writer->SetQFormMatrix(qform);
+    writer->SetFileName(tmp.c_str());
+    writer->Write();
+  }
+  std::error_code ec;
+  if (!errors.message.empty() || !fs::exists(tmp)) {
+    fs::remove(tmp, ec);
+    if (fmt.extension == ".mhd" || fmt.extension == ".MHD") fs::remove(raw, ec);
+    throw RunError("cannot write volume '" + path + "'" +
+                   (errors.message.empty() ? std::string() : ": " + first_line(errors.message)));
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw RunError("cannot write volume '" + path + "': " + ec.message());
+  }
+}
+
+TriSurface surface_from_volume(const VoxelVolume& volume, double threshold) {
+  check_volume(volume);
+  if (!std::isfinite(threshold)) throw InputError("the threshold must be a finite number");
+  const auto [lo, hi] = std::minmax_element(volume.values.begin(), volume.values.end());
+  if (!(*hi > threshold))
+    throw InputError("nothing in the volume exceeds the threshold " + std::to_string(threshold) +
+                     " (values range from " + std::to_string(*lo) + " to " + std::to_string(*hi) +
+                     "); choose a lower threshold");
+  // One voxel of background around the grid closes the iso-surface where the object touches the
+  // border of the scan, so the result always bounds a solid.
+  const float background =
+      *lo < threshold ? *lo : static_cast<float>(threshold - std::max(1.0, std::abs(threshold)));
+  auto image = to_image(volume, 1, background);
+
+  auto contour = vtkSmartPointer<vtkFlyingEdges3D>::New();
+  contour->SetInputData(image);
+  contour->SetValue(0, threshold);
+  contour->ComputeNormalsOff();
+  contour->ComputeGradientsOff();
+  contour->ComputeScalarsOff();
+  contour->InterpolateAttributesOff();
+
+  // Inner surfaces (marrow cavities below the threshold) and loose fragments are separate
+  // components; the bone's outer surface is the largest one.
+  auto largest = vtkSmartPointer<vtkPolyDataConnectivityFilter>::New();
+  largest->SetInputConnection(contour->GetOutputPort());
+  largest->SetExtractionModeToLargestRegion();
+
+  auto clean = vtkSmartPointer<vtkCleanPolyData>::New();
+  clean->SetInputConnection(largest->GetOutputPort());
+  clean->PointMergingOn();
+  clean->SetTolerance(0.0);
+  clean->ConvertPolysToLinesOff();
+  clean->ConvertLinesToPointsOff();
+  clean->ConvertStripsToPolysOff();
+  clean->Update();
+  vtkPolyData* poly = clean->GetOutput();
+
+  TriSurface s;
+  s.vertices.resize(static_cast<std::size_t>(poly->GetNumberOfPoints()));
+  for (vtkIdType i = 0; i < poly->GetNumberOfPoints(); ++i) {
+    double p[3];
+    poly->GetPoint(i, p);
+    s.vertices[static_cast<std::size_t>(i)] = {p[0], p[1], p[2]};
+  }
+  vtkCellArray* polys = poly->GetPolys();
+  s.triangles.reserve(static_cast<std::size_t>(polys->GetNumberOfCells()));
+  vtkIdType npts = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(npts, ids);) {
+    if (npts != 3) continue;
+    const std::array<int, 3> t = {static_cast<int>(ids[0]), static_cast<int>(ids[1]),
+                                  static_cast<int>(ids[2])};
+    // Merging coincident points (an iso-value met exactly at a grid node) can collapse a
+    // triangle to an edge; it has no area and no place in a closed surface.
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    s.triangles.push_back(t);
+  }
+  if (s.triangles.empty())
+    throw InputError("the iso-surface at threshold " + std::to_string(threshold) + " is empty");
+
+  // Marching cubes orients all triangles consistently; the sign of the enclosed volume tells
+  // whether that orientation points out of the solid.
+  double six_volume = 0;
+  for (const auto& t : s.triangles) {
+    const Vec3& a = s.vertices[t[0]];
+    const Vec3& b = s.vertices[t[1]];
+    const Vec3& c = s.vertices[t[2]];
+    six_volume += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                  a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  if (six_volume < 0)
+    for (auto& t : s.triangles) std::swap(t[1], t[2]);
+  return s;
+}
+
+}  // namespace hexbite

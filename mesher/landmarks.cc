@@ -1,0 +1,162 @@
+#include "mesher/landmarks.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+
+namespace hexbite {
+
+namespace {
+
+// Every message names the file and the 1-based line so that a user can go straight to the mistake.
+[[noreturn]] void fail(const std::string& path, const YAML::Mark& mark, const std::string& what) {
+  std::string where = path;
+  if (!mark.is_null()) where += ":" + std::to_string(mark.line + 1);
+  throw InputError("landmark file " + where + ": " + what);
+}
+
+double read_number(const std::string& path, const YAML::Node& node, const std::string& what) {
+  if (!node.IsScalar()) fail(path, node.Mark(), what + " must be a number");
+  double value = 0;
+  if (!YAML::convert<double>::decode(node, value))
+    fail(path, node.Mark(), what + " must be a number, not '" + node.Scalar() + "'");
+  if (!std::isfinite(value)) fail(path, node.Mark(), what + " is not finite ('" + node.Scalar() + "')");
+  return value;
+}
+
+Vec3 read_point(const std::string& path, const YAML::Node& node, const std::string& what, double scale) {
+  if (!node.IsSequence() || node.size() != 3)
+    fail(path, node.Mark(), what + " must be a list of three coordinates [x, y, z]");
+  Vec3 p{};
+  for (std::size_t k = 0; k < 3; ++k) p[k] = scale * read_number(path, node[k], what + " coordinate");
+  return p;
+}
+
+void read_muscle(const std::string& path, const YAML::Node& node, double scale, Landmarks& out,
+                 std::set<std::string>& names) {
+  if (!node.IsMap())
+    fail(path, node.Mark(), "each muscle must be a map {name, max_force_N, insertion, origin}");
+  MuscleLine m;
+  bool has[4] = {false, false, false, false};
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    if (key == "name") {
+      if (!kv.second.IsScalar() || kv.second.Scalar().empty())
+        fail(path, kv.second.Mark(), "muscle name must be a non-empty string");
+      m.name = kv.second.Scalar();
+      has[0] = true;
+    } else if (key == "max_force_N") {
+      m.max_force_N = read_number(path, kv.second, "max_force_N");
+      if (m.max_force_N < 0) fail(path, kv.second.Mark(), "max_force_N must not be negative");
+      has[1] = true;
+    } else if (key == "insertion") {
+      m.insertion = read_point(path, kv.second, "insertion", scale);
+      has[2] = true;
+    } else if (key == "origin") {
+      m.origin = read_point(path, kv.second, "origin", scale);
+      has[3] = true;
+    } else {
+      fail(path, kv.first.Mark(),
+           "unknown muscle key '" + key + "' (expected name, max_force_N, insertion, origin)");
+    }
+  }
+  static const char* const kKeys[4] = {"name", "max_force_N", "insertion", "origin"};
+  for (int k = 0; k < 4; ++k)
+    if (!has[k])
+      fail(
+          path, node.Mark(),
+          std::string("muscle ") + (m.name.empty() ? "" : "'" + m.name + "' ") + "has no '" + kKeys[k] + "'");
+  if (!names.insert(m.name).second) fail(path, node.Mark(), "name '" + m.name + "' is given twice");
+  out.muscles.push_back(std::move(m));
+}
+
+std::string format_point(const Vec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%.4f, %.4f, %.4f]", p[0], p[1], p[2]);
+  return buf;
+}
+
+std::string format_number(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
+  return buf;
+}
+
+}  // namespace
+
+std::optional<Vec3> Landmarks::find(const std::string& name) const {
+  if (auto it = points.find(name); it != points.end()) return it->second;
+  const auto dot = name.rfind('.');
+  if (dot == std::string::npos) return std::nullopt;
+  const std::string muscle = name.substr(0, dot), part = name.substr(dot + 1);
+  for (const auto& m : muscles) {
+    if (m.name != muscle) continue;
+    if (part == "insertion") return m.insertion;
+    if (part == "origin") return m.origin;
+  }
+  return std::nullopt;
+}
+
+Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
+  if (!std::filesystem::exists(path)) throw InputError("landmark file '" + path + "' does not exist");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError("cannot read landmark file '" + path + "'");
+  } catch (const YAML::ParserException& e) {
+    fail(path, e.mark, "not valid YAML: " + e.msg);
+  }
+  if (root.IsNull()) throw InputError("landmark file '" + path + "' is empty");
+  if (!root.IsMap()) fail(path, root.Mark(), "expected a map with 'landmarks:' and 'muscles:'");
+
+  Landmarks out;
+  std::set<std::string> names;
+  try {
+    for (const auto& kv : root) {
+      const std::string key = kv.first.as<std::string>();
+      const YAML::Node& value = kv.second;
+      if (key == "landmarks") {
+        if (value.IsNull()) continue;
+        if (!value.IsMap()) fail(path, value.Mark(), "'landmarks' must map names to [x, y, z]");
+        for (const auto& lm : value) {
+          const std::string name = lm.first.as<std::string>();
+          if (!names.insert(name).second) fail(path, lm.first.Mark(), "name '" + name + "' is given twice");
+          out.points[name] = read_point(path, lm.second, "landmark '" + name + "'", scale_to_mm);
+        }
+      } else if (key == "muscles") {
+        if (value.IsNull()) continue;
+        if (!value.IsSequence()) fail(path, value.Mark(), "'muscles' must be a list");
+        for (const auto& m : value) read_muscle(path, m, scale_to_mm, out, names);
+      } else {
+        fail(path, kv.first.Mark(), "unknown section '" + key + "' (expected 'landmarks' and 'muscles')");
+      }
+    }
+  } catch (const YAML::Exception& e) {
+    // Keys that are not scalars (e.g. a list used as a key) end up here.
+    fail(path, e.mark, e.msg);
+  }
+  return out;
+}
+
+void write_landmarks(const std::string& path, const Landmarks& landmarks, const std::string& header_comment) {
+  std::ostringstream s;
+  std::istringstream header(header_comment);
+  for (std::string line; std::getline(header, line);) s << (line.empty() ? "#" : "# " + line) << '\n';
+  s << "landmarks:\n";
+  for (const auto& [name, p] : landmarks.points) s << "  " << name << ": " << format_point(p) << '\n';
+  s << "muscles:   # max_force_N is for one side\n";
+  for (const auto& m : landmarks.muscles)
+    s << "  - {name: " << m.name << ", max_force_N: " << format_number(m.max_force_N)
+      << ", insertion: " << format_point(m.insertion) << ", origin: " << format_point(m.origin) << "}\n";
+  write_file_atomically(path, s.str());
+}
+
+}  // namespace hexbite

@@ -2,6 +2,7 @@
 // and turned into a surface with marching cubes (VTK), with its landmarks and muscle lines.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -12,38 +13,56 @@ namespace hexbite {
 
 enum class MandibleVariant { kDentate, kEdentulous, kAtrophic };
 
-// Main dimensions in mm and degrees (adult averages by default).
+// Main dimensions in mm and degrees; zero means the variant's default (adult averages, see
+// docs/mandible.md for the values and their sources).
 struct MandibleParameters {
   MandibleVariant variant = MandibleVariant::kDentate;
   double voxel_mm = 1.0;
-  double arch_width_mm = 0;       // bigonial/condylar width; see the .cc for the defaults
-  double arch_depth_mm = 0;
-  double body_height_mm = 0;
-  double body_thickness_mm = 0;
-  double ramus_height_mm = 0;
-  double ramus_width_mm = 0;
-  double gonial_angle_deg = 0;
+  double arch_width_mm = 0;      // bigonial width: outer surfaces at the gonial angles
+  double arch_depth_mm = 0;      // symphysis to gonion along y, on the body's centreline
+  double body_height_mm = 0;     // lower border to alveolar crest at the first molar (bone only)
+  double body_thickness_mm = 0;  // buccolingual width of the body at the first molar
+  double ramus_height_mm = 0;    // gonion to condylion (top of the condyle)
+  double ramus_width_mm = 0;     // minimum ramus breadth, perpendicular to the posterior border
+  double gonial_angle_deg = 0;   // between the posterior ramus border and the lower border
 };
 
-// Fills the zero fields above with the defaults of the chosen variant.
+// Fills the zero fields above with the defaults of the chosen variant, then checks every value
+// against its accepted range (which keeps each part at least four voxels thick, so sampling never
+// changes the topology); throws InputError naming the parameter and the range otherwise.
 MandibleParameters complete_parameters(MandibleParameters p);
 
-// A CT-like volume: Hounsfield-like values on a regular grid, x fastest.
+// "dentate", "edentulous" or "atrophic"; parse_variant throws InputError for anything else.
+const char* variant_name(MandibleVariant variant);
+MandibleVariant parse_variant(const std::string& name);
+
+// The comment block written at the top of a generated landmark file: what made it, the frame and
+// the units, one line each.
+std::string mandible_landmark_header(const MandibleParameters& parameters);
+
+// A CT-like volume: Hounsfield-like values on a regular grid, x fastest. Voxel (i, j, k) has its
+// centre at origin + (i, j, k) * spacing.
 struct VoxelVolume {
   std::array<int, 3> dims{};
   Vec3 origin{};
   double spacing = 1.0;
   std::vector<float> values;
+  // Per-axis spacing for grids read from files whose voxels are not cubes (CT slices are often
+  // thicker than the in-plane pixel size). All zero means `spacing` on every axis.
+  Vec3 axis_spacing{};
+  Vec3 spacing_xyz() const { return axis_spacing[0] > 0 ? axis_spacing : Vec3{spacing, spacing, spacing}; }
 };
 
 struct GeneratedMandible {
-  TriSurface surface;       // closed, genus 0, outward
-  Landmarks landmarks;      // bone points snapped onto the surface
-  VoxelVolume ct;           // the sampled volume (bone ~ +1200 HU, soft tissue ~ 40 HU)
-  double threshold = 0;     // the iso-value used for the surface
+  TriSurface surface;    // closed, genus 0, outward
+  Landmarks landmarks;   // bone points snapped onto the surface
+  VoxelVolume ct;        // the sampled volume (bone ~ +1200 HU, soft tissue ~ 40 HU)
+  double threshold = 0;  // the iso-value used for the surface (620 HU, halfway bone/soft tissue)
   MandibleParameters parameters;
 };
 
+// Deterministic: the same parameters give the same surface, volume and landmarks, bit for bit.
+// Zero parameters are completed with complete_parameters().
 GeneratedMandible generate_mandible(const MandibleParameters& parameters);
 
 // Writes a VoxelVolume as MetaImage (.mha/.mhd) or NIfTI (.nii/.nii.gz) via VTK, atomically.

@@ -1,0 +1,220 @@
+// The hexbite command line as a user meets it: help and version, usage errors, and
+// `hexbite surface check` on good and bad input (exit codes, messages, no output file on failure).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+using test::read_file;
+using test::run_hexbite;
+using test::shared_data;
+using test::temp_dir;
+using test::write_file;
+
+namespace fs = std::filesystem;
+
+// A unit cube as OBJ text: vertex i has x = bit 0, y = bit 1, z = bit 2 (1-based in the file),
+// twelve outward triangles. The bad-input cases below are small edits of it.
+const char* const kCubeVertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n";
+const char* const kCubeFaces[12] = {"f 1 3 4\n", "f 1 4 2\n", "f 5 6 8\n", "f 5 8 7\n",
+                                    "f 1 2 6\n", "f 1 6 5\n", "f 3 7 8\n", "f 3 8 4\n",
+                                    "f 1 5 7\n", "f 1 7 3\n", "f 2 4 8\n", "f 2 8 6\n"};
+
+std::string cube_obj(int skip_face = -1, const std::string& extra = "") {
+  std::string text = kCubeVertices;
+  for (int i = 0; i < 12; ++i)
+    if (i != skip_face) text += kCubeFaces[i];
+  return text + extra;
+}
+
+std::string write_case(const std::string& name, const std::string& contents) {
+  const std::string path = temp_dir() + "/" + name;
+  write_file(path, contents);
+  return path;
+}
+
+// Runs `surface check FILE -o OUT [extra...]` and expects exit code 2, the message fragment on
+// standard error and no output file.
+void expect_rejected(const std::string& file, const std::string& fragment,
+                     const std::vector<std::string>& extra = {}) {
+  const std::string out = temp_dir() + "/repaired.stl";
+  std::vector<std::string> args = {"surface", "check", file, "-o", out};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const auto r = run_hexbite(args);
+  EXPECT_EQ(r.exit_code, 2) << file << "\n" << r.err;
+  EXPECT_NE(r.err.find("hexbite: error: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << "stderr lacks '" << fragment << "':\n" << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "output written despite the error";
+  // Nothing else either: no temporary file left next to the output.
+  EXPECT_TRUE(fs::is_empty(fs::path(out).parent_path()));
+}
+
+TEST(Cli, HelpAndVersion) {
+  auto r = run_hexbite({"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("surface"), std::string::npos) << r.out;
+  r = run_hexbite({"--version"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out.rfind("hexbite ", 0), 0u) << r.out;
+  r = run_hexbite({"surface", "check", "--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* option : {"FILE", "--json", "--units", "-o"})
+    EXPECT_NE(r.out.find(option), std::string::npos) << option << " missing in\n" << r.out;
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(run_hexbite({}).exit_code, 2);
+  EXPECT_EQ(run_hexbite({"--no-such-option"}).exit_code, 2);
+  EXPECT_EQ(run_hexbite({"no-such-command"}).exit_code, 2);
+  EXPECT_EQ(run_hexbite({"surface"}).exit_code, 2);
+  const auto r = run_hexbite({"surface", "check"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("FILE"), std::string::npos) << r.err;
+}
+
+TEST(Cli, RealJawChecksCleanAsJson) {
+  const auto r = run_hexbite({"surface", "check", shared_data("jaw/jaw_smooth.stl"), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"file",
+                          "triangles",
+                          "vertices",
+                          "components",
+                          "closed",
+                          "open_edges",
+                          "non_manifold_edges",
+                          "non_manifold_vertices",
+                          "consistently_oriented",
+                          "outward",
+                          "self_intersections",
+                          "degenerate_triangles",
+                          "euler_characteristic",
+                          "genus",
+                          "bbox",
+                          "volume_mm3",
+                          "min_angle_deg",
+                          "min_angle_histogram",
+                          "repairs",
+                          "problems",
+                          "usable"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["triangles"], 41760);
+  EXPECT_EQ(j["vertices"], 20882);
+  EXPECT_EQ(j["components"], 1);
+  EXPECT_EQ(j["closed"], true);
+  EXPECT_EQ(j["outward"], true);
+  EXPECT_EQ(j["genus"], 0);
+  EXPECT_NEAR(j["volume_mm3"].get<double>(), 57600.0, 288.0);
+  EXPECT_EQ(j["bbox"]["min"].size(), 3u);
+  EXPECT_EQ(j["min_angle_histogram"].size(), 12u);
+  EXPECT_TRUE(j["problems"].empty());
+  EXPECT_EQ(j["usable"], true);
+}
+
+TEST(Cli, TextReportAndQuiet) {
+  const std::string cube = write_case("cube.obj", cube_obj());
+  auto r = run_hexbite({"surface", "check", cube});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  for (const char* line :
+       {"triangles             12", "closed                yes", "genus 0", "1.0 mm^3", "usable: yes"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << " missing in\n" << r.out;
+  r = run_hexbite({"--quiet", "surface", "check", cube});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(Cli, RepairedSurfaceIsWrittenInMillimetres) {
+  // An inward cube in cm: flipped, scaled to mm and written; the written file checks clean.
+  std::string inward = kCubeVertices;
+  for (const char* f : kCubeFaces) {
+    int a, b, c;
+    ASSERT_EQ(std::sscanf(f, "f %d %d %d", &a, &b, &c), 3);
+    inward += "f " + std::to_string(a) + " " + std::to_string(c) + " " + std::to_string(b) + "\n";
+  }
+  const std::string in = write_case("inward.obj", inward);
+  const std::string out = temp_dir() + "/outward.ply";
+  auto r = run_hexbite({"surface", "check", in, "--units", "cm", "-o", out, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["repairs"].size(), 1u);
+  EXPECT_NE(j["repairs"][0].get<std::string>().find("reversed the orientation"), std::string::npos);
+  EXPECT_NEAR(j["volume_mm3"].get<double>(), 1000.0, 1e-9);
+  EXPECT_EQ(j["output"], out);
+  ASSERT_TRUE(fs::exists(out));
+
+  r = run_hexbite({"surface", "check", out, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["repairs"].empty()) << j["repairs"];
+  EXPECT_EQ(j["outward"], true);
+  EXPECT_NEAR(j["volume_mm3"].get<double>(), 1000.0, 1e-9);
+}
+
+TEST(CliBadInput, MissingFile) {
+  expect_rejected(temp_dir() + "/nowhere.stl", "does not exist");
+}
+
+TEST(CliBadInput, EmptyFile) {
+  expect_rejected(write_case("empty.stl", ""), "is empty (0 bytes)");
+}
+
+TEST(CliBadInput, TruncatedBinaryStl) {
+  std::string bytes(84 + 50 * 3, '\0');
+  bytes[80] = 10;  // announces 10 triangles, holds 3
+  expect_rejected(write_case("cut.stl", bytes), "truncated or corrupt binary STL");
+  expect_rejected(write_case("cut2.stl", bytes), "84 + 50 x 10 = 584 bytes, but the file has 234 bytes");
+}
+
+TEST(CliBadInput, NanCoordinate) {
+  expect_rejected(write_case("nan.stl",
+                             "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                             "vertex 0 NaN 0\nendloop\nendfacet\nendsolid x\n"),
+                  "line 6: the y coordinate is NaN");
+}
+
+TEST(CliBadInput, InfiniteCoordinate) {
+  std::string text = cube_obj();
+  text.replace(text.find("v 1 1 1"), 7, "v 1 inf 1");
+  expect_rejected(write_case("inf.obj", text), "line 8 (vertex 8): the y coordinate is infinite");
+}
+
+TEST(CliBadInput, OpenSurface) {
+  expect_rejected(write_case("open.obj", cube_obj(5)), "3 open edges");
+}
+
+TEST(CliBadInput, NonManifoldEdge) {
+  // A fin: a third triangle on the cube's edge 1-2.
+  expect_rejected(write_case("fin.obj", cube_obj(-1, "v 0.5 -1 -1\nf 1 2 9\n")),
+                  "1 non-manifold edge (shared by more than two triangles)");
+}
+
+TEST(CliBadInput, InconsistentOrientation) {
+  std::string text = cube_obj();
+  text.replace(text.find("f 3 8 4"), 7, "f 3 4 8");
+  expect_rejected(write_case("inconsistent.obj", text), "inconsistent orientation: 3 edges");
+}
+
+TEST(CliBadInput, UnknownExtension) {
+  expect_rejected(write_case("cube.xyz", cube_obj()),
+                  "unknown extension '.xyz'; accepted surface formats are .stl");
+}
+
+TEST(CliBadInput, UnknownUnit) {
+  expect_rejected(write_case("cube.obj", cube_obj()), "unknown length unit 'inch'", {"--units", "inch"});
+}
+
+TEST(CliBadInput, OutOfRangeIndexAndMalformedLine) {
+  expect_rejected(write_case("index.obj", cube_obj(-1, "f 1 2 42\n")),
+                  "line 21: face index 42 is out of range");
+  expect_rejected(write_case("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0 \n0 one 0\n3 0 1 2\n"),
+                  "line 5: malformed OFF line '0 one 0'");
+}
+
+}  // namespace
+}  // namespace hexbite

@@ -1,0 +1,439 @@
+// The built-in CT-like mandible, its landmark files and surface extraction from CT volumes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "common/error.h"
+#include "mesher/ct_surface.h"
+#include "mesher/landmarks.h"
+#include "mesher/mandible_generator.h"
+#include "mesher/surface_check.h"
+#include "mesher/surface_io.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+
+const GeneratedMandible& generated(MandibleVariant variant) {
+  static std::map<MandibleVariant, GeneratedMandible> cache;
+  auto it = cache.find(variant);
+  if (it == cache.end()) {
+    MandibleParameters p;
+    p.variant = variant;
+    it = cache.emplace(variant, generate_mandible(p)).first;
+  }
+  return it->second;
+}
+
+struct Box {
+  Vec3 lo, hi;
+  double size(int k) const { return hi[k] - lo[k]; }
+};
+
+Box bbox(const TriSurface& s) {
+  Box b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+  for (const auto& v : s.vertices)
+    for (int k = 0; k < 3; ++k) {
+      b.lo[k] = std::min(b.lo[k], v[k]);
+      b.hi[k] = std::max(b.hi[k], v[k]);
+    }
+  return b;
+}
+
+Vec3 sub(const Vec3& a, const Vec3& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+double dot(const Vec3& a, const Vec3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+// Distance from p to triangle abc (closest point by Voronoi regions, Ericson's Real-Time Collision
+// Detection 5.1.5), written out here so that the test does not share code with the generator.
+double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  auto dist_to = [&](const Vec3& q) { return std::sqrt(dot(sub(p, q), sub(p, q))); };
+  auto along = [](const Vec3& o, const Vec3& d, double t) {
+    return Vec3{o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+  };
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return dist_to(a);
+  const Vec3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return dist_to(b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return dist_to(along(a, ab, d1 / (d1 - d3)));
+  const Vec3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return dist_to(c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return dist_to(along(a, ac, d2 / (d2 - d6)));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return dist_to(along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return dist_to({a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
+}
+
+double distance_to_surface(const TriSurface& s, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : s.triangles)
+    best = std::min(best, point_triangle_distance(p, s.vertices[t[0]], s.vertices[t[1]], s.vertices[t[2]]));
+  return best;
+}
+
+// All heights where the vertical line through (x, y) crosses the surface.
+std::vector<double> vertical_crossings(const TriSurface& s, double x, double y) {
+  std::vector<double> z;
+  for (const auto& t : s.triangles) {
+    const Vec3 &a = s.vertices[t[0]], &b = s.vertices[t[1]], &c = s.vertices[t[2]];
+    const double det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+    if (std::abs(det) < 1e-12) continue;
+    const double l1 = ((x - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (y - a[1])) / det;
+    const double l2 = ((b[0] - a[0]) * (y - a[1]) - (x - a[0]) * (b[1] - a[1])) / det;
+    if (l1 < 0 || l2 < 0 || l1 + l2 > 1) continue;
+    z.push_back(a[2] + l1 * (b[2] - a[2]) + l2 * (c[2] - a[2]));
+  }
+  std::sort(z.begin(), z.end());
+  return z;
+}
+
+double enclosed_volume(const TriSurface& s) {
+  double six = 0;
+  for (const auto& t : s.triangles) {
+    const Vec3 &a = s.vertices[t[0]], &b = s.vertices[t[1]], &c = s.vertices[t[2]];
+    six += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return six / 6.0;
+}
+
+TEST(MandibleGenerator, EveryVariantIsClosedGenusZeroAndOutward) {
+  for (auto v : {MandibleVariant::kDentate, MandibleVariant::kEdentulous, MandibleVariant::kAtrophic}) {
+    SCOPED_TRACE(variant_name(v));
+    TriSurface s = generated(v).surface;
+    const std::size_t triangles = s.triangles.size();
+    const SurfaceReport r = check_surface(s, variant_name(v));
+    EXPECT_TRUE(r.usable()) << (r.problems.empty() ? "" : r.problems.front());
+    EXPECT_TRUE(r.closed);
+    EXPECT_TRUE(r.manifold);
+    EXPECT_TRUE(r.consistently_oriented);
+    EXPECT_TRUE(r.outward);
+    EXPECT_EQ(r.components, 1u);
+    EXPECT_EQ(r.euler_characteristic, 2);
+    EXPECT_EQ(r.genus, 0);
+    EXPECT_EQ(r.self_intersections, 0u);
+    EXPECT_EQ(r.degenerate_triangles, 0u);
+    // Nothing needed repairing: the generator's vertices are already shared and oriented.
+    EXPECT_EQ(s.triangles.size(), triangles);
+    EXPECT_GT(enclosed_volume(s), 0.0);
+  }
+}
+
+TEST(MandibleGenerator, SizeAndBoundingBoxAreAnatomical) {
+  const TriSurface& s = generated(MandibleVariant::kDentate).surface;
+  EXPECT_GE(s.triangles.size(), 25000u);
+  EXPECT_LE(s.triangles.size(), 50000u);
+  const Box b = bbox(s);
+  EXPECT_GE(b.size(0), 90.0);
+  EXPECT_LE(b.size(0), 125.0);
+  EXPECT_GE(b.size(1), 70.0);
+  EXPECT_LE(b.size(1), 105.0);
+  EXPECT_GE(b.size(2), 60.0);
+  EXPECT_LE(b.size(2), 95.0);
+  // Mirror-symmetric about x = 0 and placed like the real jaw in ../shared/data/jaw.
+  EXPECT_NEAR(b.lo[0], -b.hi[0], 1e-6);
+  EXPECT_GT(b.lo[2], 0.0);
+  EXPECT_LT(b.lo[2], 15.0);
+  EXPECT_LT(b.lo[1], -40.0);
+  EXPECT_GT(b.hi[1], 25.0);
+  const double volume_cm3 = enclosed_volume(s) / 1000.0;
+  EXPECT_GT(volume_cm3, 40.0);
+  EXPECT_LT(volume_cm3, 80.0);
+}
+
+TEST(MandibleGenerator, LandmarksHaveTheSharedNamesAndLieOnTheBone) {
+  const GeneratedMandible& g = generated(MandibleVariant::kDentate);
+  for (const char* side : {"left_", "right_"})
+    for (const char* name :
+         {"condyle_tmj_point", "coronoid_tip", "gonion", "first_molar_bite_point", "premolar_bite_point"})
+      EXPECT_TRUE(g.landmarks.points.count(std::string(side) + name)) << side << name;
+  EXPECT_TRUE(g.landmarks.points.count("incisal_point"));
+  ASSERT_EQ(g.landmarks.muscles.size(), 18u);
+  const std::vector<std::pair<std::string, double>> expected = {
+      {"superficial_masseter", 190.4},      {"deep_masseter", 81.6},
+      {"medial_pterygoid", 174.8},          {"anterior_temporalis", 158.0},
+      {"middle_temporalis", 95.6},          {"posterior_temporalis", 75.6},
+      {"inferior_lateral_pterygoid", 66.9}, {"superior_lateral_pterygoid", 28.7},
+      {"anterior_digastric", 40.0}};
+  for (const auto& [name, force] : expected)
+    for (const char* side : {"left_", "right_"}) {
+      const auto it = std::find_if(g.landmarks.muscles.begin(), g.landmarks.muscles.end(),
+                                   [&](const MuscleLine& m) { return m.name == side + name; });
+      ASSERT_NE(it, g.landmarks.muscles.end()) << side << name;
+      EXPECT_DOUBLE_EQ(it->max_force_N, force);
+      EXPECT_LE(distance_to_surface(g.surface, it->insertion), 1.0) << it->name;
+      // The skull side: every line of action is at least 15 mm long.
+      const Vec3 d = sub(it->origin, it->insertion);
+      EXPECT_GT(std::sqrt(dot(d, d)), 15.0) << it->name;
+    }
+  for (const char* name : {"left_first_molar_bite_point", "left_premolar_bite_point", "incisal_point",
+                           "left_coronoid_tip", "left_gonion"})
+    EXPECT_LE(distance_to_surface(g.surface, g.landmarks.points.at(name)), 1e-6) << name;
+  // The TMJ point is inside the condyle, 4 mm below its top, as in the real jaw's file.
+  const Vec3 tmj = g.landmarks.points.at("left_condyle_tmj_point");
+  EXPECT_GT(tmj[0], 40.0);
+  EXPECT_GT(tmj[1], 20.0);
+  EXPECT_GT(tmj[2], 70.0);
+  // Elevators pull up, the digastric pulls down and back.
+  const auto& ms = g.landmarks.muscles;
+  const auto find = [&](const std::string& n) {
+    return *std::find_if(ms.begin(), ms.end(), [&](const MuscleLine& m) { return m.name == n; });
+  };
+  for (const char* up : {"left_superficial_masseter", "left_deep_masseter", "left_medial_pterygoid",
+                         "left_anterior_temporalis", "left_middle_temporalis"})
+    EXPECT_GT(find(up).origin[2], find(up).insertion[2]) << up;
+  EXPECT_LT(find("left_anterior_digastric").origin[2], find("left_anterior_digastric").insertion[2]);
+  // Bite points are on the occlusal side: the highest crossing of their vertical line.
+  const Vec3 m1 = g.landmarks.points.at("left_first_molar_bite_point");
+  EXPECT_NEAR(vertical_crossings(g.surface, m1[0], m1[1]).back(), m1[2], 1e-6);
+}
+
+TEST(MandibleGenerator, SameParametersGiveTheSameBytes) {
+  const std::string dir = test::temp_dir();
+  MandibleParameters p;
+  p.variant = MandibleVariant::kEdentulous;
+  for (int run = 0; run < 2; ++run) {
+    const GeneratedMandible g = generate_mandible(p);
+    write_surface(dir + "/jaw" + std::to_string(run) + ".stl", g.surface);
+    write_landmarks(dir + "/jaw" + std::to_string(run) + ".yaml", g.landmarks, mandible_landmark_header(p));
+  }
+  const std::string a = test::read_file(dir + "/jaw0.stl");
+  EXPECT_GT(a.size(), 100000u);
+  EXPECT_EQ(a, test::read_file(dir + "/jaw1.stl"));
+  EXPECT_EQ(test::read_file(dir + "/jaw0.yaml"), test::read_file(dir + "/jaw1.yaml"));
+}
+
+// Body height in the molar region: the vertical extent of the bone on the line through the
+// first-molar bite point.
+double molar_body_height(const GeneratedMandible& g) {
+  const Vec3 m = g.landmarks.points.at("left_first_molar_bite_point");
+  const std::vector<double> z = vertical_crossings(g.surface, m[0], m[1]);
+  EXPECT_GE(z.size(), 2u);
+  return z.back() - z.front();
+}
+
+TEST(MandibleGenerator, AtrophicBodyIsClearlyLower) {
+  const double dentate = molar_body_height(generated(MandibleVariant::kDentate));
+  const double edentulous = molar_body_height(generated(MandibleVariant::kEdentulous));
+  const double atrophic = molar_body_height(generated(MandibleVariant::kAtrophic));
+  EXPECT_GT(dentate, 28.0);  // bone plus the fused crowns
+  EXPECT_LT(edentulous, dentate - 5.0);
+  EXPECT_LT(atrophic, edentulous - 5.0);
+  EXPECT_LT(atrophic, 16.0);
+  EXPECT_GT(atrophic, 8.0);
+}
+
+TEST(MandibleGenerator, ParametersChangeTheGeometry) {
+  const Box base = bbox(generated(MandibleVariant::kDentate).surface);
+  MandibleParameters wide;
+  wide.arch_width_mm = 110;
+  const Box w = bbox(generate_mandible(wide).surface);
+  EXPECT_GT(w.size(0), base.size(0) + 10.0);
+
+  MandibleParameters tall;
+  tall.ramus_height_mm = 70;
+  const Box t = bbox(generate_mandible(tall).surface);
+  EXPECT_GT(t.hi[2], base.hi[2] + 8.0);
+
+  MandibleParameters deep;
+  deep.arch_depth_mm = 65;
+  const Box d = bbox(generate_mandible(deep).surface);
+  EXPECT_GT(d.size(1), base.size(1) + 5.0);
+}
+
+TEST(MandibleGenerator, RejectsParametersOutsideTheirRanges) {
+  MandibleParameters p;
+  p.body_height_mm = 3;
+  EXPECT_THROW(complete_parameters(p), InputError);
+  p = {};
+  p.gonial_angle_deg = 200;
+  EXPECT_THROW(complete_parameters(p), InputError);
+  p = {};
+  p.voxel_mm = -1;
+  EXPECT_THROW(generate_mandible(p), InputError);
+  EXPECT_THROW(parse_variant("healthy"), InputError);
+  EXPECT_EQ(parse_variant("atrophic"), MandibleVariant::kAtrophic);
+}
+
+TEST(Landmarks, RoundTripAndFind) {
+  const GeneratedMandible& g = generated(MandibleVariant::kDentate);
+  const std::string path = test::temp_dir() + "/jaw.landmarks.yaml";
+  write_landmarks(path, g.landmarks, "a header\nsecond line");
+  const std::string text = test::read_file(path);
+  EXPECT_EQ(text.rfind("# a header\n# second line\n", 0), 0u);
+  const Landmarks back = read_landmarks(path);
+  ASSERT_EQ(back.points.size(), g.landmarks.points.size());
+  for (const auto& [name, p] : g.landmarks.points)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(back.points.at(name)[k], p[k], 1e-4) << name;
+  ASSERT_EQ(back.muscles.size(), g.landmarks.muscles.size());
+  for (std::size_t i = 0; i < back.muscles.size(); ++i) {
+    EXPECT_EQ(back.muscles[i].name, g.landmarks.muscles[i].name);
+    EXPECT_NEAR(back.muscles[i].max_force_N, g.landmarks.muscles[i].max_force_N, 1e-4);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(back.muscles[i].insertion[k], g.landmarks.muscles[i].insertion[k], 1e-4);
+      EXPECT_NEAR(back.muscles[i].origin[k], g.landmarks.muscles[i].origin[k], 1e-4);
+    }
+  }
+  const auto ins = back.find("left_deep_masseter.insertion");
+  ASSERT_TRUE(ins.has_value());
+  EXPECT_NEAR((*ins)[2], g.landmarks.muscles[2].insertion[2], 1e-4);
+  EXPECT_TRUE(back.find("incisal_point").has_value());
+  EXPECT_FALSE(back.find("left_deep_masseter.belly").has_value());
+  EXPECT_FALSE(back.find("nowhere").has_value());
+}
+
+TEST(Landmarks, ReadsTheSharedRealJawFile) {
+  const Landmarks lm = read_landmarks(test::shared_data("jaw/landmarks.yaml"));
+  EXPECT_EQ(lm.muscles.size(), 18u);
+  EXPECT_EQ(lm.points.size(), 4u);
+  const auto tmj = lm.find("left_condyle_tmj_point");
+  ASSERT_TRUE(tmj.has_value());
+  EXPECT_NEAR((*tmj)[0], 51.78, 1e-9);
+  EXPECT_EQ(lm.muscles.front().name, "left_superficial_masseter");
+  EXPECT_DOUBLE_EQ(lm.muscles.front().max_force_N, 190.4);
+  // Scaling converts units (a file in cm read with 10 mm/cm).
+  const Landmarks cm = read_landmarks(test::shared_data("jaw/landmarks.yaml"), 10.0);
+  EXPECT_NEAR(cm.points.at("left_condyle_tmj_point")[2], 796.4, 1e-9);
+}
+
+void expect_landmark_error(const std::string& contents, const std::string& expected_fragment) {
+  const std::string path = test::temp_dir() + "/bad.yaml";
+  test::write_file(path, contents);
+  try {
+    read_landmarks(path);
+    ADD_FAILURE() << "no error for:\n" << contents;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(expected_fragment), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
+  expect_landmark_error("landmarks:\n  a: [1, 2]\n", ":2: landmark 'a' must be a list of three");
+  expect_landmark_error("landmarks:\n  a: [1, 2, x]\n", ":2: landmark 'a' coordinate must be a number");
+  expect_landmark_error("landmarks: {a: [1, 2, 3]\n", "not valid YAML");
+  expect_landmark_error("muscles:\n  - {name: m, max_force_N: 1, insertion: [0, 0, 0]}\n",
+                        ":2: muscle 'm' has no 'origin'");
+  expect_landmark_error("muscles:\n  - {name: m, max_force_N: -1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
+                        "must not be negative");
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n", ":3: unknown section 'muscle'");
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  a: [1, 2, 4]\n", "given twice");
+  expect_landmark_error("", "is empty");
+  EXPECT_THROW(read_landmarks(test::temp_dir() + "/missing.yaml"), InputError);
+}
+
+TEST(CtVolume, WritesAndReadsMetaImageAndNifti) {
+  const VoxelVolume& ct = generated(MandibleVariant::kAtrophic).ct;
+  for (const char* name : {"jaw.mha", "jaw.mhd", "jaw.nii", "jaw.nii.gz"}) {
+    SCOPED_TRACE(name);
+    const std::string path = test::temp_dir() + "/" + name;
+    write_volume(path, ct);
+    const VoxelVolume back = read_volume(path);
+    EXPECT_EQ(back.dims, ct.dims);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(back.origin[k], ct.origin[k], 1e-4);
+      EXPECT_NEAR(back.spacing_xyz()[k], ct.spacing, 1e-6);
+    }
+    ASSERT_EQ(back.values.size(), ct.values.size());
+    EXPECT_TRUE(back.values == ct.values);
+  }
+  EXPECT_THROW(read_volume(test::temp_dir() + "/missing.mha"), InputError);
+  const std::string bad = test::temp_dir() + "/jaw.raw";
+  test::write_file(bad, "1234");
+  EXPECT_THROW(read_volume(bad), InputError);
+  const std::string garbage = test::temp_dir() + "/garbage.nii";
+  test::write_file(garbage, "this is not a NIfTI header");
+  EXPECT_THROW(read_volume(garbage), InputError);
+}
+
+TEST(CtVolume, SurfaceFromVolumeMatchesTheGeneratorAndRejectsHighThresholds) {
+  const GeneratedMandible& g = generated(MandibleVariant::kAtrophic);
+  const TriSurface s = surface_from_volume(g.ct, g.threshold);
+  EXPECT_EQ(s.triangles.size(), g.surface.triangles.size());
+  EXPECT_NEAR(enclosed_volume(s), enclosed_volume(g.surface), 1e-6 * enclosed_volume(s));
+  EXPECT_THROW(surface_from_volume(g.ct, 5000.0), InputError);
+  // An object touching the border of the scan is still closed (the volume is padded).
+  VoxelVolume full = g.ct;
+  std::fill(full.values.begin(), full.values.end(), 1000.0f);
+  TriSurface box = surface_from_volume(full, 500.0);
+  const SurfaceReport r = check_surface(box);
+  EXPECT_TRUE(r.closed);
+  EXPECT_EQ(r.genus, 0);
+}
+
+TEST(Cli, GenerateThenSurfaceFromCtReproducesTheVolume) {
+  const std::string dir = test::temp_dir();
+  const auto gen = test::run_hexbite({"generate", "mandible", "-o", dir + "/jaw.stl", "--landmarks",
+                                      dir + "/jaw.landmarks.yaml", "--ct", dir + "/jaw.mha"});
+  ASSERT_EQ(gen.exit_code, 0) << gen.err;
+  EXPECT_NE(gen.out.find("triangles"), std::string::npos);
+  EXPECT_NE(gen.out.find("gonial angle 122"), std::string::npos) << gen.out;
+  const auto ct = test::run_hexbite(
+      {"surface", "from-ct", dir + "/jaw.mha", "--threshold", "620", "-o", dir + "/from_ct.stl"});
+  ASSERT_EQ(ct.exit_code, 0) << ct.err;
+  const double v0 = enclosed_volume(read_surface(dir + "/jaw.stl"));
+  const double v1 = enclosed_volume(read_surface(dir + "/from_ct.stl"));
+  EXPECT_NEAR(v1, v0, 0.01 * v0);
+  const Landmarks lm = read_landmarks(dir + "/jaw.landmarks.yaml");
+  EXPECT_EQ(lm.muscles.size(), 18u);
+  EXPECT_NE(test::read_file(dir + "/jaw.landmarks.yaml").find("+x = subject's left"), std::string::npos);
+}
+
+TEST(Cli, GenerateRejectsBadOptionsWithoutWritingAnything) {
+  const std::string dir = test::temp_dir();
+  const auto bad_variant =
+      test::run_hexbite({"generate", "mandible", "-o", dir + "/jaw.stl", "--variant", "healthy"});
+  EXPECT_EQ(bad_variant.exit_code, 2);
+  EXPECT_NE(bad_variant.err.find("unknown mandible variant"), std::string::npos) << bad_variant.err;
+  const auto bad_ct =
+      test::run_hexbite({"generate", "mandible", "-o", dir + "/jaw.stl", "--ct", dir + "/jaw.png"});
+  EXPECT_EQ(bad_ct.exit_code, 2);
+  const auto bad_range =
+      test::run_hexbite({"generate", "mandible", "-o", dir + "/jaw.stl", "--gonial-angle", "170"});
+  EXPECT_EQ(bad_range.exit_code, 2);
+  EXPECT_NE(bad_range.err.find("--gonial-angle"), std::string::npos) << bad_range.err;
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(Cli, SurfaceFromCtBadInputsExitTwoWithoutOutput) {
+  const std::string dir = test::temp_dir();
+  write_volume(dir + "/jaw.nii.gz", generated(MandibleVariant::kAtrophic).ct);
+  const std::string out = dir + "/out.stl";
+  const auto missing =
+      test::run_hexbite({"surface", "from-ct", dir + "/none.mha", "--threshold", "620", "-o", out});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("does not exist"), std::string::npos) << missing.err;
+  test::write_file(dir + "/jaw.dcm", "DICM");
+  const auto unknown =
+      test::run_hexbite({"surface", "from-ct", dir + "/jaw.dcm", "--threshold", "620", "-o", out});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown volume format"), std::string::npos) << unknown.err;
+  const auto high =
+      test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "3000", "-o", out});
+  EXPECT_EQ(high.exit_code, 2);
+  EXPECT_NE(high.err.find("nothing in the volume exceeds"), std::string::npos) << high.err;
+  EXPECT_FALSE(fs::exists(out));
+  const auto ok =
+      test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "620", "-o", out});
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace hexbite

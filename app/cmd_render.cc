@@ -1,0 +1,34 @@
+// `hexbite render`: a picture of a surface for reports and the README.
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+#include "common/progress.h"
+#include "mesher/surface_io.h"
+#include "mesher/units.h"
+#include "postprocess/render.h"
+
+namespace hexbite {
+
+void add_render_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("render", "Render a surface to a PNG picture (needs an X display)");
+  struct Args {
+    std::string input, output, units = "mm";
+    RenderOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("INPUT", args->input, "Surface file (STL, OBJ, PLY, OFF, VTP)")->required();
+  cmd->add_option("-o,--output", args->output, "PNG file to write")->required();
+  cmd->add_option("--units", args->units, "Length unit of the input: mm, cm or m");
+  cmd->add_option("--view", args->options.view, "iso, side (from the right), front, back or top");
+  cmd->add_option("--width", args->options.width, "Picture width in pixels")->check(CLI::Range(64, 8192));
+  cmd->add_option("--height", args->options.height, "Picture height in pixels")->check(CLI::Range(64, 8192));
+  cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner");
+  cmd->add_flag("!--no-edges", args->options.edges, "Do not draw the element edges");
+  cmd->callback([args] {
+    const TriSurface surface = read_surface(args->input, unit_to_mm(args->units));
+    render_surface_png(surface, args->output, args->options);
+    info("wrote " + args->output);
+  });
+}
+
+}  // namespace hexbite

@@ -1,0 +1,623 @@
+#include "mesher/grid_mesher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/progress.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_quality_kernel.h"
+#include "mesher/surface_projector.h"
+
+namespace hexbite {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+using detail::cross;
+using detail::dot;
+using detail::sub;
+
+Vec3 add(const Vec3& a, const Vec3& b) {
+  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+}
+Vec3 scale(const Vec3& a, double s) {
+  return {a[0] * s, a[1] * s, a[2] * s};
+}
+double norm(const Vec3& a) {
+  return std::sqrt(dot(a, a));
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string format_point(const Vec3& p) {
+  std::ostringstream s;
+  s.precision(1);
+  s << std::fixed << "(" << p[0] << ", " << p[1] << ", " << p[2] << ") mm";
+  return s.str();
+}
+
+// A regular grid of n[0] x n[1] x n[2] cubic cells of size h; cell (i, j, k) spans
+// origin + h * [i, i+1] x [j, j+1] x [k, k+1]. The outermost layer of cells lies outside the surface's
+// bounding box, so the unselected cells always surround the selected ones.
+struct Grid {
+  Vec3 origin{};
+  double h = 1;
+  std::array<int, 3> n{};
+
+  long cells() const { return long(n[0]) * n[1] * n[2]; }
+  long cell(int i, int j, int k) const { return (long(k) * n[1] + j) * n[0] + i; }
+  void ijk(long c, int& i, int& j, int& k) const {
+    i = int(c % n[0]);
+    j = int((c / n[0]) % n[1]);
+    k = int(c / (long(n[0]) * n[1]));
+  }
+  Vec3 centre(int i, int j, int k) const {
+    return {origin[0] + (i + 0.5) * h, origin[1] + (j + 0.5) * h, origin[2] + (k + 0.5) * h};
+  }
+  long vertex(int i, int j, int k) const { return (long(k) * (n[1] + 1) + j) * (n[0] + 1) + i; }
+};
+
+// The selected cells for one cell size, with the data needed to repair and score them.
+struct Selection {
+  Grid grid;
+  std::vector<char> inside;   // cell centre inside the surface
+  std::vector<double> score;  // signed distance of the cell centre (positive inside); NaN = not computed
+  std::vector<char> selected;
+  int added_for_manifold = 0;
+  int dropped = 0;
+  Vec3 dropped_centroid{};
+  long core_cells = 0;
+  long boundary_quads = 0;
+};
+
+double cell_score(Selection& s, const SurfaceProjector& surface, long c) {
+  if (std::isnan(s.score[c])) {
+    int i, j, k;
+    s.grid.ijk(c, i, j, k);
+    const double d = surface.distance(s.grid.centre(i, j, k));
+    s.score[c] = s.inside[c] ? d : -d;
+  }
+  return s.score[c];
+}
+
+// Face neighbours of a cell inside the grid, as cell indices (fewer at the grid's border).
+int face_neighbours(const Grid& g, long c, long out[6]) {
+  int i, j, k, m = 0;
+  g.ijk(c, i, j, k);
+  if (i > 0) out[m++] = c - 1;
+  if (i + 1 < g.n[0]) out[m++] = c + 1;
+  if (j > 0) out[m++] = c - g.n[0];
+  if (j + 1 < g.n[1]) out[m++] = c + g.n[0];
+  if (k > 0) out[m++] = c - long(g.n[0]) * g.n[1];
+  if (k + 1 < g.n[2]) out[m++] = c + long(g.n[0]) * g.n[1];
+  return m;
+}
+
+// Inside flags of all cell centres: crossing parity along each grid column, with a per-cell inside test
+// where the column grazes an edge or a vertex of the surface.
+void classify(Selection& s, const SurfaceProjector& surface) {
+  const Grid& g = s.grid;
+  s.inside.assign(g.cells(), 0);
+  std::vector<double> t;
+  for (int j = 0; j < g.n[1]; ++j)
+    for (int i = 0; i < g.n[0]; ++i) {
+      const Vec3 c0 = g.centre(i, j, 0);
+      const Vec3 a{c0[0], c0[1], g.origin[2] - g.h};
+      const Vec3 b{c0[0], c0[1], g.origin[2] + (g.n[2] + 1) * g.h};
+      const bool ok = surface.segment_crossings(a, b, &t);
+      for (int k = 0; k < g.n[2]; ++k) {
+        const Vec3 c = g.centre(i, j, k);
+        bool in;
+        if (ok) {
+          const double tc = (c[2] - a[2]) / (b[2] - a[2]);
+          in = (std::lower_bound(t.begin(), t.end(), tc) - t.begin()) % 2 == 1;
+        } else {
+          in = surface.inside(c);
+        }
+        s.inside[g.cell(i, j, k)] = in;
+      }
+    }
+}
+
+// Selects the core cells: centres inside, at least margin * h from the surface. Distances are computed only
+// for inside cells within a few cells of an outside cell; deeper cells are far enough by construction.
+void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
+  const Grid& g = s.grid;
+  const long nc = g.cells();
+  s.score.assign(nc, std::numeric_limits<double>::quiet_NaN());
+  const int reach = int(std::ceil(margin)) + 1;
+  std::vector<char> near(nc, 0);
+  for (long c = 0; c < nc; ++c) {
+    if (s.inside[c]) continue;
+    int i, j, k;
+    g.ijk(c, i, j, k);
+    for (int dk = -reach; dk <= reach; ++dk)
+      for (int dj = -reach; dj <= reach; ++dj)
+        for (int di = -reach; di <= reach; ++di) {
+          const int a = i + di, b = j + dj, e = k + dk;
+          if (a < 0 || b < 0 || e < 0 || a >= g.n[0] || b >= g.n[1] || e >= g.n[2]) continue;
+          near[g.cell(a, b, e)] = 1;
+        }
+  }
+  s.selected.assign(nc, 0);
+  for (long c = 0; c < nc; ++c) {
+    if (!s.inside[c]) continue;
+    if (!near[c]) {
+      s.score[c] = kInf;
+      s.selected[c] = 1;
+    } else {
+      s.selected[c] = cell_score(s, surface, c) >= margin * g.h;
+    }
+  }
+}
+
+// Keeps the largest face-connected component of the selected cells (the first one on a tie).
+void keep_largest_component(Selection& s) {
+  const Grid& g = s.grid;
+  const long nc = g.cells();
+  std::vector<int> label(nc, -1);
+  std::vector<long> sizes;
+  for (long c = 0; c < nc; ++c) {
+    if (!s.selected[c] || label[c] >= 0) continue;
+    const int id = int(sizes.size());
+    long size = 0;
+    std::vector<long> stack{c};
+    label[c] = id;
+    while (!stack.empty()) {
+      const long x = stack.back();
+      stack.pop_back();
+      ++size;
+      long nb[6];
+      const int m = face_neighbours(g, x, nb);
+      for (int q = 0; q < m; ++q)
+        if (s.selected[nb[q]] && label[nb[q]] < 0) label[nb[q]] = id, stack.push_back(nb[q]);
+    }
+    sizes.push_back(size);
+  }
+  if (sizes.empty()) return;
+  const int keep = int(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  Vec3 sum{0, 0, 0};
+  for (long c = 0; c < nc; ++c)
+    if (s.selected[c] && label[c] != keep) {
+      s.selected[c] = 0;
+      ++s.dropped;
+      int i, j, k;
+      g.ijk(c, i, j, k);
+      sum = add(sum, g.centre(i, j, k));
+    }
+  if (s.dropped > 0) s.dropped_centroid = scale(sum, 1.0 / s.dropped);
+}
+
+// Selects every unselected cell that the outside cannot reach through faces (an enclosed cavity).
+int fill_cavities(Selection& s) {
+  const Grid& g = s.grid;
+  const long nc = g.cells();
+  std::vector<char> reached(nc, 0);
+  std::vector<long> stack{0};  // cell 0 is in the outer layer, never selected
+  reached[0] = 1;
+  while (!stack.empty()) {
+    const long x = stack.back();
+    stack.pop_back();
+    long nb[6];
+    const int m = face_neighbours(g, x, nb);
+    for (int q = 0; q < m; ++q)
+      if (!s.selected[nb[q]] && !reached[nb[q]]) reached[nb[q]] = 1, stack.push_back(nb[q]);
+  }
+  int filled = 0;
+  for (long c = 0; c < nc; ++c)
+    if (!s.selected[c] && !reached[c]) s.selected[c] = 1, ++filled;
+  return filled;
+}
+
+// True when the cells of a 2 x 2 x 2 block flagged in `mask` (bit b = di + 2 dj + 4 dk) are face-connected
+// within the block.
+bool block_connected(int mask) {
+  if (mask == 0) return true;
+  int first = 0;
+  while (!(mask >> first & 1)) ++first;
+  int seen = 1 << first, frontier = seen;
+  while (frontier) {
+    int next = 0;
+    for (int b = 0; b < 8; ++b)
+      if (frontier >> b & 1)
+        for (int axis = 0; axis < 3; ++axis) {
+          const int nb = b ^ (1 << axis);
+          if ((mask >> nb & 1) && !(seen >> nb & 1)) next |= 1 << nb;
+        }
+    seen |= next;
+    frontier = next;
+  }
+  return seen == mask;
+}
+
+// A 2 x 2 x 2 block is manifold at its centre vertex when the selected cells and the unselected cells are
+// each face-connected within the block, and no face of the block holds exactly a diagonal pair (two cells
+// that share only the edge through the centre).
+bool block_manifold(int mask) {
+  static const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                  {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+  for (const auto& f : faces) {
+    const int a = mask >> f[0] & 1, b = mask >> f[1] & 1, c = mask >> f[2] & 1, d = mask >> f[3] & 1;
+    if (a == c && b == d && a != b) return false;
+  }
+  return block_connected(mask) && block_connected(~mask & 0xff);
+}
+
+// Adds cells until every grid vertex is manifold: in each offending block the unselected cell whose centre
+// lies deepest inside the surface is added. Only adds, so it terminates.
+void make_manifold(Selection& s, const SurfaceProjector& surface) {
+  const Grid& g = s.grid;
+  static const std::array<bool, 256> manifold_table = [] {
+    std::array<bool, 256> t{};
+    for (int m = 0; m < 256; ++m) t[m] = block_manifold(m);
+    return t;
+  }();
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    for (int k = 1; k < g.n[2]; ++k)
+      for (int j = 1; j < g.n[1]; ++j)
+        for (int i = 1; i < g.n[0]; ++i) {
+          long cells[8];
+          int mask = 0;
+          for (int b = 0; b < 8; ++b) {
+            cells[b] = g.cell(i - 1 + (b & 1), j - 1 + (b >> 1 & 1), k - 1 + (b >> 2 & 1));
+            if (s.selected[cells[b]]) mask |= 1 << b;
+          }
+          if (manifold_table[mask]) continue;
+          int best = -1;
+          double best_score = -kInf;
+          for (int b = 0; b < 8; ++b)
+            if (!(mask >> b & 1)) {
+              const double sc = cell_score(s, surface, cells[b]);
+              if (best < 0 || sc > best_score) best = b, best_score = sc;
+            }
+          s.selected[cells[best]] = 1;
+          ++s.added_for_manifold;
+          changed = true;
+        }
+    if (fill_cavities(s) > 0) changed = true;
+  }
+}
+
+void count_cells(Selection& s) {
+  const Grid& g = s.grid;
+  s.core_cells = 0;
+  s.boundary_quads = 0;
+  for (long c = 0; c < g.cells(); ++c) {
+    if (!s.selected[c]) continue;
+    ++s.core_cells;
+    long nb[6];
+    const int m = face_neighbours(g, c, nb);
+    for (int q = 0; q < m; ++q) s.boundary_quads += !s.selected[nb[q]];
+  }
+}
+
+Selection build_selection(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, double h,
+                          double margin) {
+  Selection s;
+  s.grid.h = h;
+  for (int a = 0; a < 3; ++a) {
+    s.grid.n[a] = int(std::ceil((hi[a] - lo[a]) / h)) + 2;
+    // Centre the grid on the bounding box, so that the result does not depend on which corner is lower.
+    s.grid.origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * s.grid.n[a] * h;
+  }
+  classify(s, surface);
+  select_core(s, surface, margin);
+  keep_largest_component(s);
+  fill_cavities(s);
+  make_manifold(s, surface);
+  count_cells(s);
+  return s;
+}
+
+// The core hex mesh of the selected cells, vertices numbered in grid order.
+HexMesh core_mesh(const Selection& s) {
+  const Grid& g = s.grid;
+  std::vector<int> id(std::size_t(g.n[0] + 1) * (g.n[1] + 1) * (g.n[2] + 1), -1);
+  for (long c = 0; c < g.cells(); ++c) {
+    if (!s.selected[c]) continue;
+    int i, j, k;
+    g.ijk(c, i, j, k);
+    for (int b = 0; b < 8; ++b) id[g.vertex(i + (b & 1), j + (b >> 1 & 1), k + (b >> 2 & 1))] = 0;
+  }
+  HexMesh mesh;
+  for (int k = 0; k <= g.n[2]; ++k)
+    for (int j = 0; j <= g.n[1]; ++j)
+      for (int i = 0; i <= g.n[0]; ++i) {
+        int& v = id[g.vertex(i, j, k)];
+        if (v < 0) continue;
+        v = int(mesh.vertices.size());
+        mesh.vertices.push_back({g.origin[0] + i * g.h, g.origin[1] + j * g.h, g.origin[2] + k * g.h});
+      }
+  for (long c = 0; c < g.cells(); ++c) {
+    if (!s.selected[c]) continue;
+    int i, j, k;
+    g.ijk(c, i, j, k);
+    mesh.hexes.push_back({id[g.vertex(i, j, k)], id[g.vertex(i + 1, j, k)], id[g.vertex(i + 1, j + 1, k)],
+                          id[g.vertex(i, j + 1, k)], id[g.vertex(i, j, k + 1)], id[g.vertex(i + 1, j, k + 1)],
+                          id[g.vertex(i + 1, j + 1, k + 1)], id[g.vertex(i, j + 1, k + 1)]});
+  }
+  return mesh;
+}
+
+// Adds the pillow layer: a copy of every core boundary vertex on the surface and one hex per boundary quad.
+int add_pillow_layer(HexMesh& mesh, const SurfaceProjector& surface, double h) {
+  const HexBoundary boundary = extract_boundary(mesh);
+  const QuadSurface& q = boundary.surface;
+  // Area-weighted vertex normals of the core boundary (the cross product of a quad's diagonals).
+  std::vector<Vec3> normal(q.vertices.size(), Vec3{0, 0, 0});
+  for (const auto& quad : q.quads) {
+    const Vec3 n =
+        cross(sub(q.vertices[quad[2]], q.vertices[quad[0]]), sub(q.vertices[quad[3]], q.vertices[quad[1]]));
+    for (int v : quad) normal[v] = add(normal[v], n);
+  }
+  std::vector<int> copy(q.vertices.size());
+  for (std::size_t i = 0; i < q.vertices.size(); ++i) {
+    Vec3 p = q.vertices[i];
+    const double len = norm(normal[i]);
+    const Vec3 n = len > 0 ? scale(normal[i], 1.0 / len) : Vec3{0, 0, 1};
+    // A core vertex that pokes out of the surface or lies almost on it would give a flat or inverted pillow
+    // hex: pull it below the surface first, by a third of a cell, or less where the solid is thin (a third
+    // of the thickness measured along the inward normal), so that vertices from opposite sides of a thin
+    // part do not cross.
+    const SurfacePoint near = surface.closest(p);
+    if (!surface.inside(p) || near.distance < 0.25 * h) {
+      double depth = h / 3.0;
+      SurfacePoint opposite;
+      const Vec3 inward = scale(near.normal, -1.0);
+      const Vec3 start = add(near.point, scale(inward, 1e-6 * h));
+      if (surface.first_hit(start, inward, 3.0 * h, &opposite)) depth = std::min(depth, opposite.distance / 3.0);
+      p = add(near.point, scale(inward, depth));
+      mesh.vertices[boundary.boundary_vertices[i]] = p;
+    }
+    // The copy goes where the vertex normal meets the surface, which spreads the copies evenly on concave
+    // and convex parts alike; when the ray misses or travels much farther than the closest point, the
+    // closest point is used instead.
+    SurfacePoint hit;
+    const SurfacePoint closest = surface.closest(p);
+    Vec3 target = closest.point;
+    if (surface.first_hit(p, n, 3.0 * h, &hit) && hit.distance <= 2.0 * closest.distance + 0.25 * h)
+      target = hit.point;
+    copy[i] = int(mesh.vertices.size());
+    mesh.vertices.push_back(target);
+  }
+  for (const auto& quad : q.quads) {
+    const int a = boundary.boundary_vertices[quad[0]], b = boundary.boundary_vertices[quad[1]],
+              c = boundary.boundary_vertices[quad[2]], d = boundary.boundary_vertices[quad[3]];
+    // The quad is counter-clockwise seen from outside, so it is the bottom face of a hex whose top face
+    // (the copies) lies outside it.
+    mesh.hexes.push_back({a, b, c, d, copy[quad[0]], copy[quad[1]], copy[quad[2]], copy[quad[3]]});
+  }
+  return int(q.quads.size());
+}
+
+// Surface regions farther than `limit` from the mesh boundary, grouped by shared triangle vertices.
+std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
+                                               const std::vector<double>& vertex_dist,
+                                               const std::vector<double>& centroid_dist, double limit) {
+  const std::size_t nt = surface.triangles.size();
+  std::vector<int> parent(surface.vertices.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<char> far_triangle(nt, 0);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = surface.triangles[t];
+    bool far = centroid_dist[t] > limit;
+    for (int v : tri) far = far || vertex_dist[v] > limit;
+    if (!far) continue;
+    far_triangle[t] = 1;
+    const int r0 = find(tri[0]);
+    parent[find(tri[1])] = r0;
+    parent[find(tri[2])] = r0;
+  }
+  std::vector<int> region(surface.vertices.size(), -1);
+  std::vector<UnresolvedPart> parts;
+  std::vector<Vec3> sums;
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (!far_triangle[t]) continue;
+    const auto& tri = surface.triangles[t];
+    const int root = find(tri[0]);
+    if (region[root] < 0) {
+      region[root] = int(parts.size());
+      parts.push_back({});
+      sums.push_back({0, 0, 0});
+    }
+    UnresolvedPart& p = parts[region[root]];
+    const Vec3& a = surface.vertices[tri[0]];
+    const Vec3& b = surface.vertices[tri[1]];
+    const Vec3& c = surface.vertices[tri[2]];
+    sums[region[root]] = add(sums[region[root]], scale(add(add(a, b), c), 1.0 / 3.0));
+    ++p.samples;
+    p.extent = std::max(p.extent, centroid_dist[t]);
+    for (int v : tri) p.extent = std::max(p.extent, vertex_dist[v]);
+  }
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    parts[r].location = scale(sums[r], 1.0 / parts[r].samples);
+    parts[r].what = "the surface near " + format_point(parts[r].location) + " lies up to " +
+                    std::to_string(parts[r].extent) + " mm from the mesh (" +
+                    std::to_string(parts[r].samples) +
+                    " triangles): a part too thin for this cell size; ask for more hexes to resolve it";
+  }
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const UnresolvedPart& a, const UnresolvedPart& b) { return a.extent > b.extent; });
+  return parts;
+}
+
+}  // namespace
+
+double hex_mesh_volume(const HexMesh& mesh) {
+  // Reference coordinates of the VTK hexahedron's nodes.
+  static const double ref[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                   {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const double gp[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
+  double volume = 0;
+  for (const auto& h : mesh.hexes) {
+    for (int q = 0; q < 8; ++q) {
+      const double xi[3] = {gp[q & 1], gp[q >> 1 & 1], gp[q >> 2 & 1]};
+      double j[3][3] = {};
+      for (int n = 0; n < 8; ++n) {
+        double dn[3];
+        for (int a = 0; a < 3; ++a) {
+          dn[a] = ref[n][a] ? 1.0 : -1.0;
+          for (int b = 0; b < 3; ++b)
+            if (b != a) dn[a] *= ref[n][b] ? xi[b] : 1.0 - xi[b];
+        }
+        const Vec3& x = mesh.vertices[h[n]];
+        for (int r = 0; r < 3; ++r)
+          for (int a = 0; a < 3; ++a) j[r][a] += x[r] * dn[a];
+      }
+      const double det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) -
+                         j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0]) +
+                         j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+      volume += det / 8.0;
+    }
+  }
+  return volume;
+}
+
+MeshFidelity measure_fidelity(const HexMesh& mesh, const SurfaceProjector& surface) {
+  MeshFidelity f;
+  const HexBoundary boundary = extract_boundary(mesh);
+  const QuadSurface& q = boundary.surface;
+
+  // The boundary as triangles, four per quad around its bilinear centre, for distances to the mesh.
+  TriSurface tri;
+  tri.vertices = q.vertices;
+  for (const auto& quad : q.quads) {
+    Vec3 c{0, 0, 0};
+    for (int v : quad) c = add(c, scale(q.vertices[v], 0.25));
+    const int ci = int(tri.vertices.size());
+    tri.vertices.push_back(c);
+    for (int e = 0; e < 4; ++e) tri.triangles.push_back({quad[e], quad[(e + 1) % 4], ci});
+  }
+  // Mesh to surface: boundary vertices, quad centres and edge midpoints.
+  for (const Vec3& p : tri.vertices)
+    f.hausdorff_mesh_to_surface = std::max(f.hausdorff_mesh_to_surface, surface.distance(p));
+  for (const auto& quad : q.quads)
+    for (int e = 0; e < 4; ++e) {
+      const Vec3 m = scale(add(q.vertices[quad[e]], q.vertices[quad[(e + 1) % 4]]), 0.5);
+      f.hausdorff_mesh_to_surface = std::max(f.hausdorff_mesh_to_surface, surface.distance(m));
+    }
+  // Surface to mesh: surface vertices and triangle centroids.
+  const SurfaceProjector mesh_boundary(tri);
+  const TriSurface& s = surface.surface();
+  std::vector<double> vertex_dist(s.vertices.size()), centroid_dist(s.triangles.size());
+  for (std::size_t v = 0; v < s.vertices.size(); ++v) vertex_dist[v] = mesh_boundary.distance(s.vertices[v]);
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const auto& tr = s.triangles[t];
+    const Vec3 c = scale(add(add(s.vertices[tr[0]], s.vertices[tr[1]]), s.vertices[tr[2]]), 1.0 / 3.0);
+    centroid_dist[t] = mesh_boundary.distance(c);
+  }
+  for (double d : vertex_dist) f.hausdorff_surface_to_mesh = std::max(f.hausdorff_surface_to_mesh, d);
+  for (double d : centroid_dist) f.hausdorff_surface_to_mesh = std::max(f.hausdorff_surface_to_mesh, d);
+  f.hausdorff = std::max(f.hausdorff_mesh_to_surface, f.hausdorff_surface_to_mesh);
+
+  std::vector<std::pair<int, int>> edges;
+  static const int kEdges[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                    {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  edges.reserve(mesh.hexes.size() * 12);
+  for (const auto& h : mesh.hexes)
+    for (const auto& e : kEdges) edges.emplace_back(std::min(h[e[0]], h[e[1]]), std::max(h[e[0]], h[e[1]]));
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  double sum = 0;
+  for (const auto& e : edges) sum += norm(sub(mesh.vertices[e.first], mesh.vertices[e.second]));
+  f.mean_edge_length = edges.empty() ? 0.0 : sum / edges.size();
+
+  f.mesh_volume = hex_mesh_volume(mesh);
+  f.surface_volume = enclosed_volume(s);
+  f.volume_difference = f.surface_volume != 0 ? (f.mesh_volume - f.surface_volume) / f.surface_volume : 0.0;
+  f.unresolved = unresolved_regions(s, vertex_dist, centroid_dist, 0.5 * f.mean_edge_length);
+  return f;
+}
+
+HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
+  if (options.target_hexes < 8)
+    throw InputError("grid mesher: the target hex count must be at least 8, got " +
+                     std::to_string(options.target_hexes));
+  const auto t_start = std::chrono::steady_clock::now();
+  GridMeshReport report;
+  const SurfaceProjector projector(surface);
+  const double volume = enclosed_volume(surface);
+  if (!(volume > 0))
+    throw InputError("grid mesher: the surface encloses no volume (is it oriented outward?)");
+  Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+  for (const Vec3& p : surface.vertices)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+
+  // The cell size: secant steps on log(total hexes) against log(h), where total = core cells + core
+  // boundary quads (one pillow hex each). The count falls like h^-2 to h^-3; start from the slope -2.5.
+  const double target = double(options.target_hexes);
+  Progress progress("grid core");
+  double h = std::cbrt(volume / target);
+  Selection best;
+  double best_error = kInf;
+  double prev_h = 0, prev_total = 0;
+  for (int step = 0; step < 8; ++step) {
+    Selection s = build_selection(projector, lo, hi, h, options.margin);
+    const double total = double(s.core_cells + s.boundary_quads);
+    const double error = std::fabs(total - target) / target;
+    if (s.core_cells > 0 && error < best_error) best_error = error, best = std::move(s);
+    progress.update(double(step + 1) / 8,
+                    "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
+    if (best_error < 0.02) break;
+    double slope = -2.5;
+    if (prev_total > 0 && total > 0 && prev_h != h) {
+      const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
+      if (fitted < -1.0 && fitted > -4.0) slope = fitted;
+    }
+    prev_h = h;
+    prev_total = total;
+    h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
+  }
+  progress.finish();
+  if (best.core_cells == 0)
+    throw InputError("grid mesher: no grid cell fits inside the surface; the solid is too thin for " +
+                     std::to_string(options.target_hexes) + " hexes, ask for more");
+  report.cell_size = best.grid.h;
+  report.grid = best.grid.n;
+  report.cells_added_for_manifold = best.added_for_manifold;
+  report.cells_in_dropped_components = best.dropped;
+  HexMesh mesh = core_mesh(best);
+  report.core_hexes = int(mesh.hexes.size());
+  report.seconds_core = seconds_since(t_start);
+
+  auto t0 = std::chrono::steady_clock::now();
+  report.pillow_hexes = add_pillow_layer(mesh, projector, best.grid.h);
+  report.seconds_pillow = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  report.optimize = optimize_hex_mesh(mesh, &projector, {}, options.optimize);
+  report.seconds_optimize = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  report.fidelity = measure_fidelity(mesh, projector);
+  if (best.dropped > 0) {
+    UnresolvedPart part;
+    part.location = best.dropped_centroid;
+    part.samples = best.dropped;
+    part.what =
+        std::to_string(best.dropped) + " grid cells around " + format_point(best.dropped_centroid) +
+        " were not face-connected to the main core and were dropped (a narrow neck at this cell size)";
+    report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
+  }
+  report.seconds_fidelity = seconds_since(t0);
+  report.seconds_total = seconds_since(t_start);
+  if (report_out) *report_out = std::move(report);
+  return mesh;
+}
+
+}  // namespace hexbite

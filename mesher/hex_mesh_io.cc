@@ -1,0 +1,585 @@
+#include "mesher/hex_mesh_io.h"
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCellTypes.h>
+#include <vtkCommand.h>
+#include <vtkDataArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkIdTypeArray.h>
+#include <vtkLogger.h>
+#include <vtkNew.h>
+#include <vtkOutputWindow.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringOutputWindow.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "mesher/hex_quality.h"
+
+namespace hexbite {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Shortest decimal text that reads back to the same double, so text files round-trip exactly.
+std::string format_double(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// The checks every reader makes before parsing: the file exists, is a regular file, is not empty and opens.
+void check_readable(const std::string& path, const char* what) {
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw InputError("cannot read " + std::string(what) + " '" + path + "': the file does not exist");
+  if (fs::is_directory(path, ec))
+    throw InputError("cannot read " + std::string(what) + " '" + path + "': it is a directory, not a file");
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe)
+    throw InputError("cannot read " + std::string(what) + " '" + path +
+                     "': the file cannot be opened (check permissions)");
+  if (fs::file_size(path, ec) == 0)
+    throw InputError("cannot read " + std::string(what) + " '" + path + "': the file is empty");
+}
+
+// Checks vertex coordinates and hex indices of a mesh just read; `where` names the file.
+void check_mesh(const HexMesh& mesh, const std::string& where) {
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    for (double c : mesh.vertices[v])
+      if (!std::isfinite(c))
+        throw InputError(where + ": vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+  const long n = static_cast<long>(mesh.vertices.size());
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    for (int v : mesh.hexes[h])
+      if (v < 0 || v >= n)
+        throw InputError(where + ": hexahedron " + std::to_string(h) + " refers to vertex " +
+                         std::to_string(v) + ", but there are only " + std::to_string(n) + " vertices");
+}
+
+void check_arrays(const std::vector<MeshArray>& arrays, std::size_t count, const char* kind,
+                  std::set<std::string>& names) {
+  for (const MeshArray& a : arrays) {
+    if (a.name.empty())
+      throw std::invalid_argument(std::string("write_vtu: a ") + kind + " array has no name");
+    if (!names.insert(a.name).second)
+      throw std::invalid_argument("write_vtu: array name '" + a.name + "' is reserved or used twice");
+    if (a.components < 1 || a.values.size() != count * static_cast<std::size_t>(a.components))
+      throw std::invalid_argument("write_vtu: " + std::string(kind) + " array '" + a.name + "' has " +
+                                  std::to_string(a.values.size()) + " values, expected " +
+                                  std::to_string(count) + " x " + std::to_string(a.components));
+  }
+}
+
+vtkSmartPointer<vtkDoubleArray> make_vtk_array(const std::string& name, int components,
+                                               const std::vector<double>& values) {
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name.c_str());
+  array->SetNumberOfComponents(components);
+  array->SetNumberOfTuples(static_cast<vtkIdType>(values.size() / components));
+  std::copy(values.begin(), values.end(), array->GetPointer(0));
+  return array;
+}
+
+std::vector<MeshArray> arrays_of(vtkFieldData* data) {
+  std::vector<MeshArray> out;
+  for (int i = 0; i < data->GetNumberOfArrays(); ++i) {
+    vtkDataArray* a = data->GetArray(i);
+    if (a == nullptr) continue;  // string or other non-numeric arrays
+    MeshArray m;
+    m.name = a->GetName() ? a->GetName() : "";
+    m.components = a->GetNumberOfComponents();
+    m.values.resize(static_cast<std::size_t>(a->GetNumberOfTuples()) * m.components);
+    for (vtkIdType t = 0; t < a->GetNumberOfTuples(); ++t)
+      for (int c = 0; c < m.components; ++c) m.values[t * m.components + c] = a->GetComponent(t, c);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+// Collects the error messages a VTK reader emits, so that they reach the user inside an InputError instead
+// of being printed by VTK's output window.
+class ErrorCollector : public vtkCommand {
+ public:
+  static ErrorCollector* New() { return new ErrorCollector; }
+  void Execute(vtkObject*, unsigned long, void* call_data) override {
+    if (call_data != nullptr && messages.empty()) messages = static_cast<const char*>(call_data);
+  }
+  std::string messages;
+};
+
+// Routes VTK's global output window into a string while a reader runs, and restores it afterwards. Helper
+// objects inside the reader (the XML parser) report errors there rather than to an observer; their text says
+// what is wrong (for example "no element found" at a given line) and goes into our InputError instead of
+// being printed to the terminal.
+// VTK 9 also sends every error to its logger, which prints to stderr by itself; that sink is muted for the
+// same span. The logger has no getter for the stderr level alone, so the overall cutoff (the stderr level
+// unless a log file was opened) is what gets restored.
+class CapturedVtkOutput {
+ public:
+  CapturedVtkOutput()
+      : previous_(vtkOutputWindow::GetInstance()),
+        previous_verbosity_(vtkLogger::GetCurrentVerbosityCutoff()) {
+    vtkOutputWindow::SetInstance(capture_);
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+  }
+  ~CapturedVtkOutput() {
+    vtkLogger::SetStderrVerbosity(previous_verbosity_);
+    vtkOutputWindow::SetInstance(previous_);
+  }
+  std::string text() { return capture_->GetOutput(); }
+
+ private:
+  vtkSmartPointer<vtkOutputWindow> previous_;
+  vtkLogger::Verbosity previous_verbosity_;
+  vtkNew<vtkStringOutputWindow> capture_;
+};
+
+// The first VTK message of `text` without its source location prefix ("vtkClass (0x...): ").
+std::string first_vtk_message(const std::string& text) {
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const auto cut = line.find("): ");
+    if (cut != std::string::npos) line = line.substr(cut + 3);
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    if (!line.empty() && line.rfind("ERROR: In ", 0) != 0) return line;
+  }
+  return "";
+}
+
+}  // namespace
+
+void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<MeshArray>& cell_arrays,
+               const std::vector<MeshArray>& point_arrays) {
+  std::set<std::string> names(std::begin(kVtuQualityArrays), std::end(kVtuQualityArrays));
+  check_arrays(cell_arrays, mesh.hexes.size(), "cell", names);
+  names.clear();
+  check_arrays(point_arrays, mesh.vertices.size(), "point", names);
+
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.vertices.size()));
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    points->SetPoint(static_cast<vtkIdType>(v), mesh.vertices[v].data());
+
+  vtkNew<vtkIdTypeArray> offsets;
+  vtkNew<vtkIdTypeArray> connectivity;
+  offsets->SetNumberOfValues(static_cast<vtkIdType>(mesh.hexes.size() + 1));
+  connectivity->SetNumberOfValues(static_cast<vtkIdType>(mesh.hexes.size() * 8));
+  for (std::size_t h = 0; h <= mesh.hexes.size(); ++h) offsets->SetValue(h, static_cast<vtkIdType>(8 * h));
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    for (int k = 0; k < 8; ++k) connectivity->SetValue(8 * h + k, mesh.hexes[h][k]);
+  vtkNew<vtkCellArray> cells;
+  cells->SetData(offsets, connectivity);
+
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  grid->SetCells(VTK_HEXAHEDRON, cells);
+
+  const HexQualityField q = compute_hex_quality(mesh);
+  const std::vector<double>* quality[4] = {&q.scaled_jacobian, &q.condition, &q.oddy, &q.jacobian};
+  for (int i = 0; i < 4; ++i)
+    grid->GetCellData()->AddArray(make_vtk_array(kVtuQualityArrays[i], 1, *quality[i]));
+  for (const MeshArray& a : cell_arrays)
+    grid->GetCellData()->AddArray(make_vtk_array(a.name, a.components, a.values));
+  for (const MeshArray& a : point_arrays)
+    grid->GetPointData()->AddArray(make_vtk_array(a.name, a.components, a.values));
+
+  write_atomically(path, [&](const std::string& tmp) {
+    vtkNew<vtkXMLUnstructuredGridWriter> writer;
+    writer->SetFileName(tmp.c_str());
+    writer->SetInputData(grid);
+    writer->SetDataModeToAppended();
+    writer->EncodeAppendedDataOff();
+    writer->SetCompressorTypeToZLib();
+    writer->SetHeaderTypeToUInt64();
+    writer->SetIdTypeToInt64();
+    vtkNew<ErrorCollector> errors;
+    writer->AddObserver(vtkCommand::ErrorEvent, errors);
+    if (writer->Write() != 1 || !errors->messages.empty())
+      throw RunError("cannot write '" + path + "': " +
+                     (errors->messages.empty() ? std::string("VTK writer failed") : errors->messages));
+  });
+}
+
+HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
+                 std::vector<MeshArray>* point_arrays) {
+  check_readable(path, "hex mesh");
+  const std::string where = "hex mesh '" + path + "'";
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  vtkNew<ErrorCollector> errors;
+  std::string parser_text;
+  {
+    CapturedVtkOutput capture;
+    if (reader->CanReadFile(path.c_str()) == 0)
+      throw InputError(
+          "cannot read " + where +
+          ": not a VTK XML unstructured grid (.vtu) file; expected a <VTKFile type=\"UnstructuredGrid\"> "
+          "document");
+    reader->SetFileName(path.c_str());
+    reader->AddObserver(vtkCommand::ErrorEvent, errors);
+    reader->Update();
+    parser_text = capture.text();
+  }
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  // Warnings (for example about an unknown array type) do not make a file unreadable; errors do.
+  if (!errors->messages.empty() || parser_text.find("ERROR") != std::string::npos || grid == nullptr) {
+    std::string msg = first_vtk_message(parser_text);
+    if (msg.empty()) msg = first_vtk_message(errors->messages);
+    throw InputError("cannot read " + where + ": the file is damaged or truncated (VTK: " +
+                     (msg.empty() ? std::string("no output") : msg) + ")");
+  }
+  const vtkIdType num_points = grid->GetNumberOfPoints();
+  const vtkIdType num_cells = grid->GetNumberOfCells();
+  if (num_points > std::numeric_limits<int>::max() || num_cells > std::numeric_limits<int>::max())
+    throw InputError("cannot read " + where + ": more than 2^31 points or cells are not supported");
+
+  HexMesh mesh;
+  mesh.vertices.resize(num_points);
+  for (vtkIdType v = 0; v < num_points; ++v) grid->GetPoint(v, mesh.vertices[v].data());
+  mesh.hexes.resize(num_cells);
+  for (vtkIdType c = 0; c < num_cells; ++c) {
+    const int type = grid->GetCellType(c);
+    if (type != VTK_HEXAHEDRON) {
+      const char* name = vtkCellTypes::GetClassNameFromTypeId(type);
+      throw InputError(where + ": cell " + std::to_string(c) + " is a " + (name ? name : "unknown cell") +
+                       " (VTK cell type " + std::to_string(type) +
+                       "); only hexahedra (VTK_HEXAHEDRON, type 12) are accepted");
+    }
+    vtkIdType npts = 0;
+    const vtkIdType* pts = nullptr;
+    grid->GetCellPoints(c, npts, pts);
+    if (npts != 8)
+      throw InputError(where + ": hexahedron " + std::to_string(c) + " has " + std::to_string(npts) +
+                       " vertices instead of 8");
+    for (int k = 0; k < 8; ++k) {
+      if (pts[k] < 0 || pts[k] >= num_points)
+        throw InputError(where + ": hexahedron " + std::to_string(c) + " refers to vertex " +
+                         std::to_string(pts[k]) + ", but there are only " + std::to_string(num_points) +
+                         " vertices");
+      mesh.hexes[c][k] = static_cast<int>(pts[k]);
+    }
+  }
+  check_mesh(mesh, where);
+  if (cell_arrays != nullptr) *cell_arrays = arrays_of(grid->GetCellData());
+  if (point_arrays != nullptr) *point_arrays = arrays_of(grid->GetPointData());
+  return mesh;
+}
+
+namespace {
+
+void check_set(const IndexSet& set, std::size_t count, const char* kind, std::set<std::string>& names) {
+  const std::string& n = set.name;
+  bool ok = !n.empty() && n.size() <= 80 && std::isalpha(static_cast<unsigned char>(n[0]));
+  for (char ch : n) ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_');
+  if (!ok)
+    throw std::invalid_argument(
+        "write_inp: " + std::string(kind) + " set name '" + n +
+        "' must start with a letter and hold only letters, digits and '_' (at most 80)");
+  std::string upper = n;
+  for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  // Abaqus names are case-insensitive, so NAll would collide with the NALL set written for all nodes.
+  if (!names.insert(upper).second)
+    throw std::invalid_argument("write_inp: set name '" + n +
+                                "' is reserved or used twice (names ignore case)");
+  for (int id : set.ids)
+    if (id < 0 || static_cast<std::size_t>(id) >= count)
+      throw std::invalid_argument("write_inp: " + std::string(kind) + " set '" + n + "' holds index " +
+                                  std::to_string(id) + ", out of range [0, " + std::to_string(count) + ")");
+}
+
+// Abaqus allows at most 16 entries per data line of a set.
+void write_set(std::ostringstream& out, const char* keyword, const IndexSet& set) {
+  out << '*' << keyword << ", " << keyword << '=' << set.name << '\n';
+  for (std::size_t i = 0; i < set.ids.size(); ++i) {
+    out << set.ids[i] + 1;
+    out << ((i % 16 == 15 || i + 1 == set.ids.size()) ? "\n" : ", ");
+  }
+}
+
+}  // namespace
+
+void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<IndexSet>& node_sets,
+               const std::vector<IndexSet>& element_sets) {
+  std::set<std::string> names = {"NALL", "EALL"};
+  for (const IndexSet& s : node_sets) check_set(s, mesh.vertices.size(), "node", names);
+  for (const IndexSet& s : element_sets) check_set(s, mesh.hexes.size(), "element", names);
+
+  std::ostringstream out;
+  out << "** hexbite hex mesh: " << mesh.vertices.size() << " nodes, " << mesh.hexes.size()
+      << " C3D8 elements; units mm (add material and steps in N, MPa)\n";
+  out << "*NODE, NSET=NALL\n";
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Vec3& p = mesh.vertices[v];
+    out << v + 1 << ", " << format_double(p[0]) << ", " << format_double(p[1]) << ", " << format_double(p[2])
+        << '\n';
+  }
+  // C3D8 numbers its nodes like VTK_HEXAHEDRON: face 1-2-3-4, then 5-6-7-8 above it.
+  out << "*ELEMENT, TYPE=C3D8, ELSET=EALL\n";
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    out << h + 1;
+    for (int v : mesh.hexes[h]) out << ", " << v + 1;
+    out << '\n';
+  }
+  for (const IndexSet& s : node_sets) write_set(out, "NSET", s);
+  for (const IndexSet& s : element_sets) write_set(out, "ELSET", s);
+  write_file_atomically(path, out.str());
+}
+
+void write_msh(const std::string& path, const HexMesh& mesh) {
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = v == 0 ? mesh.vertices[v][d] : std::min(lo[d], mesh.vertices[v][d]);
+      hi[d] = v == 0 ? mesh.vertices[v][d] : std::max(hi[d], mesh.vertices[v][d]);
+    }
+  const std::size_t n = mesh.vertices.size(), m = mesh.hexes.size();
+  std::ostringstream out;
+  out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+  // One volume entity without physical groups or bounding surfaces holds every node and element.
+  out << "$Entities\n0 0 0 1\n1 " << format_double(lo[0]) << ' ' << format_double(lo[1]) << ' '
+      << format_double(lo[2]) << ' ' << format_double(hi[0]) << ' ' << format_double(hi[1]) << ' '
+      << format_double(hi[2]) << " 0 0\n$EndEntities\n";
+  out << "$Nodes\n1 " << n << ' ' << (n ? 1 : 0) << ' ' << n << "\n3 1 0 " << n << '\n';
+  for (std::size_t v = 0; v < n; ++v) out << v + 1 << '\n';
+  for (const Vec3& p : mesh.vertices)
+    out << format_double(p[0]) << ' ' << format_double(p[1]) << ' ' << format_double(p[2]) << '\n';
+  out << "$EndNodes\n";
+  // Gmsh's 8-node hexahedron (type 5) numbers its nodes like VTK_HEXAHEDRON.
+  out << "$Elements\n1 " << m << ' ' << (m ? 1 : 0) << ' ' << m << "\n3 1 5 " << m << '\n';
+  for (std::size_t h = 0; h < m; ++h) {
+    out << h + 1;
+    for (int v : mesh.hexes[h]) out << ' ' << v + 1;
+    out << '\n';
+  }
+  out << "$EndElements\n";
+  write_file_atomically(path, out.str());
+}
+
+namespace {
+
+// Line-oriented reader of an ASCII .msh file that names the file and line in its errors.
+class MshReader {
+ public:
+  explicit MshReader(const std::string& path) : path_(path), in_(path) {}
+
+  bool next_line(std::string& line) {
+    if (!std::getline(in_, line)) return false;
+    ++line_no_;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  }
+  std::istringstream numbers() {
+    std::string line;
+    if (!next_line(line)) fail("the file ends early");
+    return std::istringstream(line);
+  }
+  template <typename... T>
+  void read(std::istringstream& s, T&... values) {
+    if (!((s >> values) && ...)) fail("expected more numbers on this line");
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InputError("cannot read Gmsh mesh '" + path_ + "', line " + std::to_string(line_no_) + ": " + what);
+  }
+  void expect_end(const std::string& section) {
+    std::string line;
+    if (!next_line(line) || line != "$End" + section) fail("expected $End" + section);
+  }
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  long line_no_ = 0;
+};
+
+// Dimension of the Gmsh element types we may meet; 0 for types we do not know.
+int gmsh_element_dimension(int type) {
+  switch (type) {
+    case 15:
+      return 0;
+    case 1:
+    case 8:
+    case 26:
+    case 27:
+    case 28:
+      return 1;
+    case 2:
+    case 3:
+    case 9:
+    case 10:
+    case 16:
+    case 20:
+    case 21:
+    case 22:
+    case 23:
+    case 24:
+    case 25:
+      return 2;
+    case 4:
+    case 5:
+    case 6:
+    case 7:
+    case 11:
+    case 12:
+    case 13:
+    case 14:
+    case 17:
+    case 18:
+    case 19:
+    case 29:
+    case 92:
+    case 93:
+      return 3;
+    default:
+      return -1;
+  }
+}
+
+}  // namespace
+
+HexMesh read_msh(const std::string& path) {
+  check_readable(path, "Gmsh mesh");
+  MshReader r(path);
+  HexMesh mesh;
+  std::unordered_map<long, int> node_index;
+  std::string line, version;
+  bool have_format = false, have_nodes = false, have_elements = false;
+  auto add_node = [&](long tag, const Vec3& p) {
+    if (!node_index.emplace(tag, static_cast<int>(mesh.vertices.size())).second)
+      r.fail("node tag " + std::to_string(tag) + " appears twice");
+    mesh.vertices.push_back(p);
+  };
+  auto add_element = [&](long tag, int type, const std::vector<long>& nodes) {
+    const int dim = gmsh_element_dimension(type);
+    if (dim < 0)
+      r.fail("element " + std::to_string(tag) + " has unknown element type " + std::to_string(type));
+    if (dim < 3) return;
+    if (type != 5)
+      r.fail("element " + std::to_string(tag) + " is a volume element of Gmsh type " + std::to_string(type) +
+             "; only 8-node hexahedra (type 5) are accepted");
+    if (nodes.size() != 8) r.fail("hexahedron " + std::to_string(tag) + " does not have 8 nodes");
+    std::array<int, 8> hex;
+    for (int k = 0; k < 8; ++k) {
+      const auto it = node_index.find(nodes[k]);
+      if (it == node_index.end())
+        r.fail("hexahedron " + std::to_string(tag) + " refers to node " + std::to_string(nodes[k]) +
+               ", which is not in $Nodes");
+      hex[k] = it->second;
+    }
+    mesh.hexes.push_back(hex);
+  };
+
+  while (r.next_line(line)) {
+    if (line == "$MeshFormat") {
+      auto s = r.numbers();
+      int file_type = -1;
+      s >> version >> file_type;
+      if (version != "4.1" && version != "2.2")
+        r.fail("format version " + version + " is not supported; save the mesh as version 4.1 or 2.2");
+      if (file_type != 0) r.fail("binary .msh files are not supported; save the mesh as ASCII");
+      r.expect_end("MeshFormat");
+      have_format = true;
+    } else if (line == "$Nodes") {
+      if (!have_format) r.fail("$Nodes before $MeshFormat");
+      if (version == "4.1") {
+        auto s = r.numbers();
+        long blocks = 0, count = 0, lo = 0, hi = 0;
+        r.read(s, blocks, count, lo, hi);
+        for (long b = 0; b < blocks; ++b) {
+          auto bs = r.numbers();
+          int dim = 0, entity = 0, parametric = 0;
+          long in_block = 0;
+          r.read(bs, dim, entity, parametric, in_block);
+          std::vector<long> tags(in_block);
+          for (long& t : tags) {
+            auto ts = r.numbers();
+            r.read(ts, t);
+          }
+          for (long t : tags) {
+            auto cs = r.numbers();
+            Vec3 p;
+            r.read(cs, p[0], p[1], p[2]);
+            add_node(t, p);
+          }
+        }
+      } else {
+        auto s = r.numbers();
+        long count = 0;
+        r.read(s, count);
+        for (long i = 0; i < count; ++i) {
+          auto ns = r.numbers();
+          long tag = 0;
+          Vec3 p;
+          r.read(ns, tag, p[0], p[1], p[2]);
+          add_node(tag, p);
+        }
+      }
+      r.expect_end("Nodes");
+      have_nodes = true;
+    } else if (line == "$Elements") {
+      if (!have_nodes) r.fail("$Elements before $Nodes");
+      std::vector<long> nodes;
+      if (version == "4.1") {
+        auto s = r.numbers();
+        long blocks = 0, count = 0, lo = 0, hi = 0;
+        r.read(s, blocks, count, lo, hi);
+        for (long b = 0; b < blocks; ++b) {
+          auto bs = r.numbers();
+          int dim = 0, entity = 0, type = 0;
+          long in_block = 0;
+          r.read(bs, dim, entity, type, in_block);
+          for (long i = 0; i < in_block; ++i) {
+            auto es = r.numbers();
+            long tag = 0, v = 0;
+            r.read(es, tag);
+            nodes.clear();
+            while (es >> v) nodes.push_back(v);
+            add_element(tag, type, nodes);
+          }
+        }
+      } else {
+        auto s = r.numbers();
+        long count = 0;
+        r.read(s, count);
+        for (long i = 0; i < count; ++i) {
+          auto es = r.numbers();
+          long tag = 0, v = 0;
+          int type = 0, num_tags = 0;
+          r.read(es, tag, type, num_tags);
+          for (int t = 0; t < num_tags; ++t) r.read(es, v);
+          nodes.clear();
+          while (es >> v) nodes.push_back(v);
+          add_element(tag, type, nodes);
+        }
+      }
+      r.expect_end("Elements");
+      have_elements = true;
+    }
+  }
+  if (!have_format) r.fail("no $MeshFormat section: not a Gmsh .msh file");
+  if (!have_elements) r.fail("no $Elements section");
+  check_mesh(mesh, "Gmsh mesh '" + path + "'");
+  return mesh;
+}
+
+}  // namespace hexbite

@@ -1,0 +1,62 @@
+// Hex mesh files: VTU (VTK XML unstructured grid) read and write, Gmsh .msh read and write, and the Abaqus /
+// CalculiX .inp export.
+//
+// Input/output: a HexMesh in VTK node order plus optional named per-cell and per-point arrays. Writers are
+// atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
+// hexahedra and throw InputError naming the file and what is wrong: missing, unreadable, not a mesh of that
+// format, a cell that is not a hexahedron (with its index and type), a NaN or infinite coordinate, a vertex
+// index out of range. Orientation is not checked here: that is the quality module's job (inverted hexes).
+// Cost: linear in the mesh size.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mesher/hex_mesh.h"
+
+namespace hexbite {
+
+// A named array with `components` values per cell or per point, stored tuple after tuple.
+struct MeshArray {
+  std::string name;
+  int components = 1;
+  std::vector<double> values;
+};
+
+// A named set of 0-based node or element indices, for solver input files.
+struct IndexSet {
+  std::string name;
+  std::vector<int> ids;
+};
+
+// Names of the per-cell quality arrays that write_vtu always adds (see mesher/hex_quality.h):
+// scaled_jacobian, condition (cube = 3), oddy and jacobian. Callers may not reuse these names.
+inline const char* const kVtuQualityArrays[4] = {"scaled_jacobian", "condition", "oddy", "jacobian"};
+
+// Writes a .vtu file: binary appended, zlib-compressed, double coordinates, VTK_HEXAHEDRON cells, with the
+// quality arrays above and the caller's extra cell and point arrays (Float64). Throws std::invalid_argument
+// when an extra array has the wrong size or a reserved or duplicate name.
+void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<MeshArray>& cell_arrays = {},
+               const std::vector<MeshArray>& point_arrays = {});
+
+// Reads a .vtu file of hexahedra. When given, cell_arrays and point_arrays receive the file's numeric
+// arrays (as doubles, in file order; the quality arrays included).
+HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
+                 std::vector<MeshArray>* point_arrays = nullptr);
+
+// Exports an Abaqus / CalculiX input deck: *NODE (NSET=NALL), *ELEMENT TYPE=C3D8 (ELSET=EALL; the C3D8 node
+// order is VTK's hexahedron order), then one *NSET / *ELSET per given set. Numbers are 1-based in the file.
+// Set names must start with a letter and hold only letters, digits and '_' (at most 80 characters), and
+// may not be NALL or EALL; violations throw std::invalid_argument. No material or step: the solver adds them.
+void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<IndexSet>& node_sets = {},
+               const std::vector<IndexSet>& element_sets = {});
+
+// Writes a Gmsh 4.1 ASCII .msh file: one volume entity, nodes tagged 1..n, hexahedra (element type 5,
+// Gmsh's node order, which equals VTK's) tagged 1..m.
+void write_msh(const std::string& path, const HexMesh& mesh);
+
+// Reads a Gmsh ASCII .msh file, format 4.1 or 2.2. Points, lines and faces are skipped; hexahedra (type 5)
+// are kept; any other volume element is an InputError. All nodes are kept, in the file's order.
+HexMesh read_msh(const std::string& path);
+
+}  // namespace hexbite

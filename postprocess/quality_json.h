@@ -1,0 +1,19 @@
+// JSON form of a hex mesh quality summary: the object `hexbite quality --json` prints and results.json
+// embeds.
+//
+// Keys: hexes, nodes, inverted, inverted_hexes (at most the first 100 indices), scaled_jacobian, jacobian,
+// condition (cube = 3), condition_verdict (cube = 1), oddy, each {count, min, mean, max} (null where count is
+// 0), node_degree {interior_nodes, edges {max, counts}, hexes {max, counts}} where counts[d] is the number of
+// interior nodes of degree d, and histograms {scaled_jacobian, condition, oddy}, each {lo, hi, counts,
+// below, above}. Cost: linear in the size of the summary.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "mesher/hex_quality.h"
+
+namespace hexbite {
+
+nlohmann::json quality_to_json(const QualitySummary& summary);
+
+}  // namespace hexbite

@@ -1,0 +1,25 @@
+// Pictures of surfaces and meshes for reports and the README (VTK, off-screen).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mesher/tri_surface.h"
+
+namespace hexbite {
+
+struct RenderOptions {
+  std::string view = "iso";  // iso | side | front | top | back
+  int width = 1200, height = 800;
+  bool edges = true;         // draw the triangle or quad edges
+  std::string title;         // optional caption in the picture's corner
+};
+
+// True when VTK can open a window here: an X display is set. Rendering without one aborts inside
+// VTK, so callers check this first and tell the user to run under `xvfb-run -a`.
+bool can_render();
+
+// Renders the triangle surface and writes a PNG atomically. Throws RunError when no display.
+void render_surface_png(const TriSurface& surface, const std::string& png_path, const RenderOptions& options);
+
+}  // namespace hexbite

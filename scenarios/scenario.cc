@@ -1,0 +1,866 @@
+#include "scenarios/scenario.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include "common/error.h"
+#include "mesher/units.h"
+
+namespace hexbite {
+
+std::string SourceLocation::str() const {
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// What every parsing function needs to know about the file it reads.
+struct Ctx {
+  std::string file;  // as given, for messages
+  fs::path folder;   // relative paths inside the scenario are resolved against it
+};
+
+[[noreturn]] void fail(const SourceLocation& where, const std::string& message) {
+  throw InputError(where.str() + ": " + message);
+}
+
+std::string quote(const std::string& s) {
+  return "'" + s + "'";
+}
+
+std::string fmt(double x) {
+  std::ostringstream out;
+  out << x;
+  return out.str();
+}
+
+std::string fmt(const Vec3& p) {
+  return "[" + fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + "]";
+}
+
+std::string join_quoted(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + quote(item);
+  return out;
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// "did you mean 'x'?" when a valid choice is within a few edits (typos), else the whole list, so that
+// the message always says what to write instead.
+std::string suggestion(const std::string& given, const std::vector<std::string>& valid,
+                       const std::string& noun = "choices") {
+  const std::string* best = nullptr;
+  size_t best_distance = std::numeric_limits<size_t>::max();
+  for (const auto& v : valid) {
+    const size_t d = edit_distance(given, v);
+    if (d < best_distance) best_distance = d, best = &v;
+  }
+  // A one-letter slip in a one-letter word is no evidence of a typo, hence the second condition.
+  if (best && best_distance <= std::max<size_t>(2, given.size() / 3) && best_distance < given.size())
+    return "did you mean " + quote(*best) + "?";
+  return "valid " + noun + " are " + join_quoted(valid);
+}
+
+std::vector<std::string> split_tokens(const std::string& name) {
+  std::vector<std::string> tokens;
+  std::string current;
+  for (char c : name) {
+    if (c == '_' || c == '.' || c == '-' || c == ' ') {
+      if (!current.empty()) tokens.push_back(current);
+      current.clear();
+    } else {
+      current += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+  }
+  if (!current.empty()) tokens.push_back(current);
+  return tokens;
+}
+
+// The known names most like `given`: landmark names are long compounds ("right_first_molar_bite_point"),
+// so a name sharing more of its words ranks first and the edit distance breaks ties.
+std::vector<std::string> closest_names(const std::string& given, const std::vector<std::string>& known,
+                                       size_t count) {
+  const auto given_tokens = split_tokens(given);
+  std::vector<std::tuple<int, size_t, std::string>> ranked;
+  for (const auto& name : known) {
+    const auto tokens = split_tokens(name);
+    int shared = 0;
+    for (const auto& t : given_tokens) shared += std::count(tokens.begin(), tokens.end(), t) > 0 ? 1 : 0;
+    ranked.emplace_back(-shared, edit_distance(given, name), name);
+  }
+  std::sort(ranked.begin(), ranked.end());
+  std::vector<std::string> out;
+  for (size_t i = 0; i < ranked.size() && i < count; ++i) out.push_back(std::get<2>(ranked[i]));
+  return out;
+}
+
+// A YAML node with where it was written and its path in the document ("muscles[2].activation").
+struct Value {
+  YAML::Node node;
+  SourceLocation at;
+  std::string path;
+};
+
+bool is_quoted(const YAML::Node& node) {
+  return node.IsScalar() && node.Tag() == "!";
+}
+
+std::string describe(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "nothing";
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a mapping";
+  if (is_quoted(node)) return "the quoted text \"" + node.Scalar() + "\"";
+  return quote(node.Scalar());
+}
+
+double to_number(const Value& v) {
+  double x = 0;
+  if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<double>::decode(v.node, x) ||
+      !std::isfinite(x))
+    fail(v.at, v.path + " must be a number, found " + describe(v.node) +
+                   "; write a plain finite number such as 2.5");
+  return x;
+}
+
+int to_int(const Value& v) {
+  long long x = 0;
+  if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<long long>::decode(v.node, x) ||
+      x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max())
+    fail(v.at,
+         v.path + " must be a whole number, found " + describe(v.node) + "; write an integer such as 3");
+  return static_cast<int>(x);
+}
+
+bool to_bool(const Value& v) {
+  bool x = false;
+  if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<bool>::decode(v.node, x))
+    fail(v.at, v.path + " must be true or false, found " + describe(v.node) + "; write true or false");
+  return x;
+}
+
+std::string to_string(const Value& v) {
+  if (!v.node.IsScalar() || v.node.Scalar().empty())
+    fail(v.at, v.path + " must be text, found " + describe(v.node) + "; write a word such as left_condyle");
+  return v.node.Scalar();
+}
+
+std::vector<Value> to_list(const Value& v) {
+  std::vector<Value> items;
+  if (v.node.IsNull()) return items;
+  if (!v.node.IsSequence())
+    fail(v.at, v.path + " must be a list, found " + describe(v.node) + "; write one '- ...' line per entry");
+  for (size_t i = 0; i < v.node.size(); ++i) {
+    const YAML::Node item = v.node[i];
+    items.push_back({item,
+                     {v.at.file, item.Mark().line + 1, item.Mark().column + 1},
+                     v.path + "[" + std::to_string(i) + "]"});
+  }
+  return items;
+}
+
+Vec3 to_vec3(const Value& v) {
+  if (!v.node.IsSequence() || v.node.size() != 3)
+    fail(v.at, v.path + " must be three numbers [x, y, z], found " + describe(v.node) +
+                   "; write e.g. [0, -20, 45]");
+  const auto items = to_list(v);
+  return {to_number(items[0]), to_number(items[1]), to_number(items[2])};
+}
+
+PointRef to_point(const Value& v) {
+  PointRef p;
+  p.where = v.at;
+  if (v.node.IsSequence()) {
+    p.xyz = to_vec3(v);
+    p.resolved = true;
+    return p;
+  }
+  double number = 0;
+  if (!v.node.IsScalar() || v.node.Scalar().empty() ||
+      (!is_quoted(v.node) && YAML::convert<double>::decode(v.node, number)))
+    fail(v.at, v.path + " must be a point, found " + describe(v.node) +
+                   "; write coordinates [x, y, z] in mm or a name (a landmark, a landmarks.points entry, "
+                   "'<muscle>.insertion' or '<muscle>.origin')");
+  p.name = v.node.Scalar();
+  return p;
+}
+
+template <typename Enum>
+Enum to_choice(const Value& v, const std::vector<std::pair<std::string, Enum>>& choices) {
+  std::vector<std::string> names;
+  for (const auto& [name, value] : choices) names.push_back(name);
+  const std::string given = to_string(v);
+  for (const auto& [name, value] : choices)
+    if (given == name) return value;
+  fail(v.at, v.path + " is " + quote(given) + ", not a valid choice; " + suggestion(given, names));
+}
+
+double positive(const Value& v, const std::string& unit_hint) {
+  const double x = to_number(v);
+  if (x <= 0)
+    fail(v.at, v.path + " is " + fmt(x) + " but must be positive" + (x < 0 ? " (it is negative)" : "") +
+                   "; give " + unit_hint);
+  return x;
+}
+
+// A mapping whose keys are checked against the valid ones on construction (unknown and repeated keys
+// are errors at the key), with access by key.
+class Map {
+ public:
+  Map(const Value& v, std::vector<std::string> valid) : at_(v.at), path_(v.path) {
+    if (v.node.IsNull()) return;  // "mesh:" with nothing after it reads as an empty mapping
+    if (!v.node.IsMap())
+      fail(v.at, what() + " must be a mapping of 'key: value' entries, found " + describe(v.node) +
+                     "; valid keys are " + join_quoted(valid));
+    for (auto it = v.node.begin(); it != v.node.end(); ++it) {
+      const SourceLocation key_at{at_.file, it->first.Mark().line + 1, it->first.Mark().column + 1};
+      if (!it->first.IsScalar())
+        fail(key_at, "a key of " + what() + " is not a plain word; write 'key: value'");
+      const std::string key = it->first.Scalar();
+      if (std::find(valid.begin(), valid.end(), key) == valid.end())
+        fail(key_at, "unknown key " + quote(key) + " in " + what() + "; " + suggestion(key, valid, "keys"));
+      if (const auto previous = entries_.find(key); previous != entries_.end())
+        fail(key_at, "key " + quote(key) + " appears twice in " + what() + " (first on line " +
+                         std::to_string(previous->second.key_at.line) + "); keep one");
+      // A null value ("key:" with nothing) carries the next line's mark; the key's mark is where it is.
+      const bool has_mark = !it->second.IsNull();
+      const SourceLocation value_at =
+          has_mark ? SourceLocation{at_.file, it->second.Mark().line + 1, it->second.Mark().column + 1}
+                   : key_at;
+      entries_.emplace(key, Entry{key_at, Value{it->second, value_at, child_path(key)}});
+    }
+  }
+
+  bool has(const std::string& key) const { return entries_.count(key) > 0; }
+  const Value& get(const std::string& key) const { return entries_.at(key).value; }
+  const SourceLocation& key_at(const std::string& key) const { return entries_.at(key).key_at; }
+  std::optional<Value> find(const std::string& key) const {
+    if (!has(key)) return std::nullopt;
+    return get(key);
+  }
+  const Value& require(const std::string& key, const std::string& example) const {
+    if (!has(key)) fail(at_, what() + " has no " + quote(key) + ", which is required; add e.g. " + example);
+    return get(key);
+  }
+  const SourceLocation& at() const { return at_; }
+  std::string what() const { return path_.empty() ? "the scenario" : path_; }
+
+ private:
+  struct Entry {
+    SourceLocation key_at;
+    Value value;
+  };
+  std::string child_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  SourceLocation at_;
+  std::string path_;
+  std::map<std::string, Entry> entries_;
+};
+
+std::string resolve_file(const Ctx& ctx, const Value& v, const std::string& kind) {
+  const std::string given = to_string(v);
+  fs::path path(given);
+  if (path.is_relative()) path = ctx.folder / path;
+  path = path.lexically_normal();
+  std::error_code error;
+  if (!fs::is_regular_file(path, error))
+    fail(v.at, kind + " file " + quote(given) + " (resolved to " + quote(path.string()) +
+                   ") does not exist or is not a file; give a path relative to the scenario file's folder or "
+                   "an absolute path");
+  return path.string();
+}
+
+const std::vector<std::pair<std::string, MandibleVariant>> kVariants = {
+    {"dentate", MandibleVariant::kDentate},
+    {"edentulous", MandibleVariant::kEdentulous},
+    {"atrophic", MandibleVariant::kAtrophic}};
+
+GeometrySpec parse_geometry(const Ctx& ctx, const Value& v) {
+  const Map map(v, {"mandible", "surface", "ct"});
+  GeometrySpec g;
+  g.where = v.at;
+  std::vector<std::string> given;
+  for (const char* key : {"mandible", "surface", "ct"})
+    if (map.has(key)) given.push_back(key);
+  if (given.empty())
+    fail(
+        v.at,
+        "geometry needs one of 'mandible', 'surface' or 'ct'; e.g. geometry: {mandible: {variant: dentate}}");
+  if (given.size() > 1)
+    fail(map.key_at(given[1]), "geometry has both " + quote(given[0]) + " and " + quote(given[1]) +
+                                   "; keep exactly one geometry source");
+  if (map.has("mandible")) {
+    g.source = GeometrySource::kMandible;
+    const Map m(map.get("mandible"),
+                {"variant", "voxel_mm", "arch_width_mm", "arch_depth_mm", "body_height_mm",
+                 "body_thickness_mm", "ramus_height_mm", "ramus_width_mm", "gonial_angle_deg"});
+    MandibleParameters& p = g.mandible;
+    if (auto x = m.find("variant")) p.variant = to_choice(*x, kVariants);
+    const std::pair<const char*, double*> lengths[] = {{"voxel_mm", &p.voxel_mm},
+                                                       {"arch_width_mm", &p.arch_width_mm},
+                                                       {"arch_depth_mm", &p.arch_depth_mm},
+                                                       {"body_height_mm", &p.body_height_mm},
+                                                       {"body_thickness_mm", &p.body_thickness_mm},
+                                                       {"ramus_height_mm", &p.ramus_height_mm},
+                                                       {"ramus_width_mm", &p.ramus_width_mm}};
+    for (const auto& [key, field] : lengths)
+      if (auto x = m.find(key))
+        *field = positive(*x, "a length in mm, or leave it out for the variant's default");
+    if (auto x = m.find("gonial_angle_deg")) {
+      p.gonial_angle_deg = to_number(*x);
+      if (p.gonial_angle_deg <= 90 || p.gonial_angle_deg >= 180)
+        fail(x->at, x->path + " is " + fmt(p.gonial_angle_deg) +
+                        " but must lie strictly between 90 and 180 degrees; adults measure about 120");
+    }
+  } else if (map.has("surface")) {
+    g.source = GeometrySource::kSurface;
+    const Map s(map.get("surface"), {"file", "units"});
+    g.file = resolve_file(ctx, s.require("file", "file: jaw.stl"), "surface");
+    if (auto x = s.find("units")) {
+      g.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
+    }
+    g.scale_to_mm = unit_to_mm(g.units);
+  } else {
+    g.source = GeometrySource::kCt;
+    const Map c(map.get("ct"), {"file", "threshold"});
+    g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume");
+    g.threshold =
+        to_number(c.require("threshold", "threshold: 400 (the bone iso-value, e.g. in Hounsfield units)"));
+  }
+  return g;
+}
+
+LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, const GeometrySpec& geometry) {
+  LandmarkSpec l;
+  // A landmark file lies in its surface's frame, so by default it shares the surface's unit.
+  l.scale_to_mm = geometry.source == GeometrySource::kSurface ? geometry.scale_to_mm : 1.0;
+  if (!v) return l;
+  const Map map(*v, {"file", "units", "points"});
+  l.where = v->at;
+  if (auto x = map.find("file")) l.file = resolve_file(ctx, *x, "landmark");
+  if (auto x = map.find("units")) {
+    if (!map.has("file"))
+      fail(map.key_at("units"),
+           "landmarks.units is given without landmarks.file; add the file or remove units");
+    l.scale_to_mm = unit_to_mm(to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}}));
+  }
+  if (auto x = map.find("points")) {
+    if (!x->node.IsNull() && !x->node.IsMap())
+      fail(x->at, "landmarks.points must be a mapping 'name: [x, y, z]', found " + describe(x->node) +
+                      "; write e.g. points: {implant_site: [0, -30, 20]}");
+    for (auto it = x->node.begin(); x->node.IsMap() && it != x->node.end(); ++it) {
+      const SourceLocation key_at{ctx.file, it->first.Mark().line + 1, it->first.Mark().column + 1};
+      const std::string name = it->first.Scalar();
+      for (const auto& earlier : l.points)
+        if (earlier.name == name)
+          fail(key_at, "point " + quote(name) + " is defined twice in landmarks.points (first on line " +
+                           std::to_string(earlier.where.line) + "); rename or remove one");
+      const SourceLocation value_at{ctx.file, it->second.Mark().line + 1, it->second.Mark().column + 1};
+      l.points.push_back({name, to_vec3({it->second, value_at, "landmarks.points." + name}), key_at});
+    }
+  }
+  return l;
+}
+
+MeshSettings parse_mesh(const Value& v) {
+  const Map map(v, {"method", "target_hexes", "validation_levels"});
+  MeshSettings m;
+  if (auto x = map.find("method"))
+    m.method = to_choice<MeshMethod>(*x, {{"grid", MeshMethod::kGrid}, {"sheets", MeshMethod::kSheets}});
+  if (auto x = map.find("target_hexes")) {
+    m.target_hexes = to_int(*x);
+    if (m.target_hexes <= 0) fail(x->at, "mesh.target_hexes must be positive; the default is 2500");
+  }
+  if (auto x = map.find("validation_levels")) {
+    m.validation_levels = to_int(*x);
+    // Each level multiplies the mesh by 8: four levels of the default mesh would be ten million hexes.
+    if (m.validation_levels < 0 || m.validation_levels > 3)
+      fail(x->at, "mesh.validation_levels is " + std::to_string(m.validation_levels) +
+                      " but must be 0 (none), 1, 2 or 3; each level refines the mesh 8-way and solves again");
+  }
+  return m;
+}
+
+double parse_E(const Value& v) {
+  const double E = to_number(v);
+  if (E <= 0)
+    fail(v.at, v.path + " is " + fmt(E) +
+                   " MPa but Young's modulus must be positive; cortical bone is about 11000 MPa");
+  return E;
+}
+
+double parse_poisson(const Value& v) {
+  const double nu = to_number(v);
+  if (nu <= -1 || nu >= 0.5)
+    fail(v.at, v.path + " is " + fmt(nu) +
+                   " but Poisson's ratio must lie strictly between -1 and 0.5 (0.5 is incompressible); bone "
+                   "is about 0.28");
+  return nu;
+}
+
+Materials parse_materials(const Value& v) {
+  const Map map(v, {"default", "regions"});
+  Materials m;
+  if (auto x = map.find("default")) {
+    const Map d(*x, {"E_MPa", "poisson"});
+    if (auto y = d.find("E_MPa")) m.default_material.E_MPa = parse_E(*y);
+    if (auto y = d.find("poisson")) m.default_material.poisson = parse_poisson(*y);
+  }
+  if (auto x = map.find("regions")) {
+    for (const Value& item : to_list(*x)) {
+      const Map r(item, {"name", "sphere", "box", "E_MPa", "poisson"});
+      MaterialRegion region;
+      region.where = item.at;
+      region.name = to_string(r.require("name", "name: implant_site"));
+      if (r.has("sphere") == r.has("box"))
+        fail(item.at, item.path + " (" + quote(region.name) +
+                          ") needs exactly one shape, 'sphere: {center, radius_mm}' or 'box: {min, max}'");
+      if (r.has("sphere")) {
+        region.shape = RegionShape::kSphere;
+        const Map s(r.get("sphere"), {"center", "radius_mm"});
+        region.center = to_point(s.require("center", "center: [0, -30, 20]"));
+        region.radius_mm = positive(s.require("radius_mm", "radius_mm: 5"), "a radius in mm");
+      } else {
+        region.shape = RegionShape::kBox;
+        const Map b(r.get("box"), {"min", "max"});
+        region.min = to_point(b.require("min", "min: [-10, -40, 10]"));
+        region.max = to_point(b.require("max", "max: [10, -20, 30]"));
+      }
+      if (!r.has("E_MPa") && !r.has("poisson"))
+        fail(item.at,
+             item.path + " (" + quote(region.name) +
+                 ") changes nothing; give E_MPa and/or poisson (the one left out keeps the default)");
+      region.material = m.default_material;
+      if (auto y = r.find("E_MPa")) region.material.E_MPa = parse_E(*y);
+      if (auto y = r.find("poisson")) region.material.poisson = parse_poisson(*y);
+      for (const auto& earlier : m.regions)
+        if (earlier.name == region.name)
+          fail(item.at, "material region " + quote(region.name) + " is defined twice (first on line " +
+                            std::to_string(earlier.where.line) + "); give each region its own name");
+      m.regions.push_back(region);
+    }
+  }
+  return m;
+}
+
+double parse_activation(const Value& v) {
+  const double a = to_number(v);
+  if (a < 0 || a > 1)
+    fail(v.at, v.path + " is " + fmt(a) +
+                   " but an activation must lie in [0, 1] (a fraction of the maximum force); write e.g. 0.5");
+  return a;
+}
+
+Muscle default_muscle(const std::string& name, const SourceLocation& where) {
+  Muscle m;
+  m.name = name;
+  m.where = where;
+  m.insertion.name = name + ".insertion";
+  m.insertion.where = where;
+  m.origin = PointRef{name + ".origin", {}, false, where};
+  return m;
+}
+
+Muscle parse_muscle(const Value& item) {
+  const Map map(item, {"name", "insertion", "radius_mm", "origin", "direction", "max_force_N", "activation"});
+  Muscle m = default_muscle(to_string(map.require("name", "name: right_superficial_masseter")), item.at);
+  if (auto x = map.find("insertion")) m.insertion = to_point(*x);
+  if (auto x = map.find("radius_mm")) m.radius_mm = positive(*x, "the insertion patch radius in mm, e.g. 10");
+  if (map.has("origin") && map.has("direction"))
+    fail(map.key_at("direction"),
+         "muscle " + quote(m.name) +
+             " has both 'origin' and 'direction'; the line of action needs exactly one");
+  if (auto x = map.find("origin")) m.origin = to_point(*x);
+  if (auto x = map.find("direction")) {
+    m.origin.reset();
+    m.direction = to_vec3(*x);
+    const Vec3& d = *m.direction;
+    if (std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) < 1e-12)
+      fail(x->at, "muscle " + quote(m.name) +
+                      " has a zero line of action (direction [0, 0, 0]); give a non-zero direction vector");
+  }
+  if (auto x = map.find("max_force_N")) m.max_force_N = positive(*x, "the maximum force in N, e.g. 190.4");
+  m.activation =
+      parse_activation(map.require("activation", "activation: 0.5 (a fraction of max_force_N in [0, 1])"));
+  return m;
+}
+
+// activation_pattern: {base: a, base: {left: a, right: b}} becomes left_<base> and right_<base> muscles
+// with every other property from the landmarks.
+std::vector<Muscle> parse_activation_pattern(const Ctx& ctx, const Value& v) {
+  std::vector<Muscle> muscles;
+  if (v.node.IsNull()) return muscles;
+  if (!v.node.IsMap())
+    fail(
+        v.at,
+        "activation_pattern must be a mapping 'muscle: activation' or 'muscle: {left: a, right: b}', found " +
+            describe(v.node) +
+            "; write e.g. activation_pattern: {superficial_masseter: {left: 0.2, right: 0.56}}");
+  for (auto it = v.node.begin(); it != v.node.end(); ++it) {
+    const SourceLocation key_at{ctx.file, it->first.Mark().line + 1, it->first.Mark().column + 1};
+    const std::string base = it->first.Scalar();
+    const SourceLocation value_at = it->second.IsNull() ? key_at
+                                                        : SourceLocation{ctx.file, it->second.Mark().line + 1,
+                                                                         it->second.Mark().column + 1};
+    const Value value{it->second, value_at, "activation_pattern." + base};
+    if (value.node.IsMap()) {
+      const Map sides(value, {"left", "right"});
+      for (const char* side : {"left", "right"})
+        if (auto x = sides.find(side)) {
+          Muscle m = default_muscle(std::string(side) + "_" + base, sides.key_at(side));
+          m.activation = parse_activation(*x);
+          muscles.push_back(m);
+        }
+    } else {
+      const double activation = parse_activation(value);
+      for (const char* side : {"left", "right"}) {
+        Muscle m = default_muscle(std::string(side) + "_" + base, key_at);
+        m.activation = activation;
+        muscles.push_back(m);
+      }
+    }
+  }
+  return muscles;
+}
+
+Support parse_support(const Value& item) {
+  const Map map(item, {"name", "at", "radius_mm", "fixed", "spring_N_per_mm3", "bite"});
+  Support s;
+  s.where = item.at;
+  s.name = to_string(map.require("name", "name: right_condyle"));
+  s.at = to_point(map.require("at", "at: right_condyle_tmj_point"));
+  s.radius_mm = positive(map.require("radius_mm", "radius_mm: 5"), "the support patch radius in mm, e.g. 5");
+  if (map.has("fixed") && map.has("spring_N_per_mm3"))
+    fail(map.key_at("spring_N_per_mm3"),
+         "support " + quote(s.name) +
+             " has both 'fixed' and 'spring_N_per_mm3'; a patch is either fixed "
+             "or elastic, keep one");
+  if (auto x = map.find("fixed")) {
+    const auto items = to_list(*x);
+    if (items.empty())
+      fail(x->at, "support " + quote(s.name) +
+                      " fixes no component; list the components to fix, e.g. [x, y, z] or [z]");
+    s.fixed = {false, false, false};
+    for (const Value& c : items) {
+      const int axis = to_choice<int>(c, {{"x", 0}, {"y", 1}, {"z", 2}});
+      if (s.fixed[axis])
+        fail(c.at, "support " + quote(s.name) + " lists component " + quote(c.node.Scalar()) +
+                       " twice; list each once");
+      s.fixed[axis] = true;
+    }
+  }
+  if (auto x = map.find("spring_N_per_mm3")) {
+    s.spring_N_per_mm3 =
+        positive(*x, "the foundation stiffness in N/mm^3 (traction per displacement), e.g. 50");
+  }
+  if (auto x = map.find("bite")) s.bite = to_bool(*x);
+  return s;
+}
+
+SolverSettings parse_solver(const Value& v) {
+  const Map map(v, {"degree", "linear_solver", "tolerance", "max_iterations"});
+  SolverSettings s;
+  if (auto x = map.find("degree")) {
+    s.degree = to_int(*x);
+    if (s.degree != 1 && s.degree != 2)
+      fail(x->at, "solver.degree is " + std::to_string(s.degree) + "; use 1 (Q1) or 2 (Q2)");
+  }
+  if (auto x = map.find("linear_solver"))
+    s.linear_solver = to_choice<LinearSolver>(
+        *x,
+        {{"auto", LinearSolver::kAuto}, {"cg_amg", LinearSolver::kCgAmg}, {"direct", LinearSolver::kDirect}});
+  if (auto x = map.find("tolerance")) {
+    s.tolerance = to_number(*x);
+    if (s.tolerance <= 0 || s.tolerance >= 1)
+      fail(x->at, "solver.tolerance is " + fmt(s.tolerance) +
+                      " but a relative tolerance must lie in (0, 1); the default is 1e-10");
+  }
+  if (auto x = map.find("max_iterations")) {
+    s.max_iterations = to_int(*x);
+    if (s.max_iterations <= 0) fail(x->at, "solver.max_iterations must be positive; the default is 10000");
+  }
+  return s;
+}
+
+Outputs parse_outputs(const Value& v) {
+  const Map map(v, {"vtu", "inp", "bite_force"});
+  Outputs o;
+  if (auto x = map.find("vtu")) o.vtu = to_bool(*x);
+  if (auto x = map.find("inp")) o.inp = to_bool(*x);
+  if (auto x = map.find("bite_force")) o.bite_force = to_bool(*x);
+  return o;
+}
+
+template <typename T>
+void check_unique_names(const std::vector<T>& items, const std::string& kind) {
+  for (size_t i = 0; i < items.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (items[i].name == items[j].name)
+        fail(items[i].where, kind + " " + quote(items[i].name) + " is defined twice (first on line " +
+                                 std::to_string(items[j].where.line) + "); give each " + kind +
+                                 " its own name");
+}
+
+// Checks that can be made before the geometry exists: something loads the bone, something holds it.
+void check_loads_and_supports(const Scenario& s, const Map& root) {
+  const SourceLocation muscles_at = root.has("muscles")              ? root.key_at("muscles")
+                                    : root.has("activation_pattern") ? root.key_at("activation_pattern")
+                                                                     : root.at();
+  if (std::none_of(s.muscles.begin(), s.muscles.end(), [](const Muscle& m) { return m.activation > 0; }))
+    fail(muscles_at,
+         "no muscle is active, so nothing loads the mandible; give at least one muscle an activation "
+         "above 0 in 'muscles' or 'activation_pattern'");
+  const SourceLocation supports_at = root.has("supports") ? root.key_at("supports") : root.at();
+  if (s.supports.empty())
+    fail(supports_at,
+         "the scenario has no supports: nothing holds the mandible, so it could move as a rigid body "
+         "and the problem is singular; add support patches, e.g. both condyles "
+         "(- {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6})");
+  std::array<bool, 3> held{false, false, false};
+  for (const Support& support : s.supports)
+    for (int axis = 0; axis < 3; ++axis)
+      held[axis] = held[axis] || support.spring_N_per_mm3 || support.fixed[axis];
+  for (int axis = 0; axis < 3; ++axis)
+    if (!held[axis])
+      fail(supports_at, std::string("no support holds the mandible along ") + "xyz"[axis] +
+                            ", so it could slide freely and the problem is singular; add that component to a "
+                            "support's 'fixed' list or use a spring support");
+  if (s.outputs.bite_force &&
+      std::none_of(s.supports.begin(), s.supports.end(), [](const Support& x) { return x.bite; }))
+    fail(supports_at,
+         "no support is marked 'bite: true', but the bite force is reported (outputs.bite_force is true "
+         "by default); mark the biting patch with 'bite: true', or set outputs.bite_force: false");
+}
+
+Scenario parse_scenario(const Ctx& ctx, const YAML::Node& root_node) {
+  const Value root_value{root_node, {ctx.file, 1, 1}, ""};
+  if (!root_node.IsMap())
+    fail(root_value.at, "a scenario must be a mapping of 'key: value' entries starting with 'name:', found " +
+                            describe(root_node) + "; see docs/scenario-format.md");
+  const Map root(root_value,
+                 {"format_version", "name", "description", "geometry", "landmarks", "mesh", "materials",
+                  "muscles", "activation_pattern", "supports", "solver", "outputs", "probes"});
+  Scenario s;
+  s.path = ctx.file;
+  if (auto x = root.find("format_version")) {
+    s.format_version = to_int(*x);
+    if (s.format_version != 1)
+      fail(x->at,
+           "format_version " + std::to_string(s.format_version) +
+               " is not known to this hexbite, which reads format_version 1; update hexbite or the file");
+  }
+  s.name = to_string(root.require("name", "name: lateral_bite"));
+  if (auto x = root.find("description"))
+    s.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x);
+  s.geometry = parse_geometry(ctx, root.require("geometry", "geometry: {mandible: {variant: dentate}}"));
+  s.landmarks = parse_landmarks(ctx, root.find("landmarks"), s.geometry);
+  if (auto x = root.find("mesh")) s.mesh = parse_mesh(*x);
+  if (auto x = root.find("materials")) s.materials = parse_materials(*x);
+  if (auto x = root.find("muscles"))
+    for (const Value& item : to_list(*x)) s.muscles.push_back(parse_muscle(item));
+  if (auto x = root.find("activation_pattern"))
+    for (Muscle& m : parse_activation_pattern(ctx, *x)) s.muscles.push_back(std::move(m));
+  if (auto x = root.find("supports"))
+    for (const Value& item : to_list(*x)) s.supports.push_back(parse_support(item));
+  if (auto x = root.find("solver")) s.solver = parse_solver(*x);
+  if (auto x = root.find("outputs")) s.outputs = parse_outputs(*x);
+  if (auto x = root.find("probes"))
+    for (const Value& item : to_list(*x)) {
+      const Map p(item, {"name", "at"});
+      s.probes.push_back({to_string(p.require("name", "name: chin")),
+                          to_point(p.require("at", "at: incisal_point")), item.at});
+    }
+  check_unique_names(s.muscles, "muscle");
+  check_unique_names(s.supports, "support");
+  check_unique_names(s.probes, "probe");
+  check_loads_and_supports(s, root);
+  return s;
+}
+
+double distance(const Vec3& a, const Vec3& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+Vec3 quad_centroid(const QuadSurface& surface, const std::array<int, 4>& quad) {
+  Vec3 c{0, 0, 0};
+  for (int v : quad)
+    for (int k = 0; k < 3; ++k) c[k] += 0.25 * surface.vertices[v][k];
+  return c;
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in || fs::is_directory(path))
+    throw InputError("cannot read scenario file '" + path + "'; check the path (scenarios are YAML files)");
+  std::stringstream text;
+  text << in.rdbuf();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    const SourceLocation where{path, e.mark.line + 1, e.mark.column + 1};
+    fail(where,
+         "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets near this place");
+  }
+  const Ctx ctx{path, fs::path(path).parent_path()};
+  if (!root.IsDefined() || root.IsNull())
+    fail({path, 1, 1},
+         "the scenario file is empty; it needs at least 'name', 'geometry', 'muscles' and 'supports' "
+         "(see docs/scenario-format.md)");
+  return parse_scenario(ctx, root);
+}
+
+void resolve_points(Scenario& s, const Landmarks& landmarks) {
+  std::map<std::string, Vec3> known = landmarks.points;
+  for (const MuscleLine& m : landmarks.muscles) {
+    known[m.name + ".insertion"] = m.insertion;
+    known[m.name + ".origin"] = m.origin;
+  }
+  for (const NamedPoint& p : s.landmarks.points) {
+    if (known.count(p.name))
+      fail(p.where,
+           "extra point " + quote(p.name) +
+               " has the name of a landmark, so the name would be ambiguous; rename it or use the landmark");
+    known[p.name] = p.xyz;
+  }
+  std::vector<std::string> known_names;
+  for (const auto& [name, xyz] : known) known_names.push_back(name);
+
+  auto resolve = [&](PointRef& p) {
+    if (p.resolved) return;
+    const auto it = known.find(p.name);
+    if (it == known.end()) {
+      if (known_names.empty())
+        fail(p.where,
+             "unknown point name " + quote(p.name) +
+                 ": there are no named points (no landmarks and no landmarks.points); give coordinates "
+                 "[x, y, z] or add the point to landmarks.points");
+      fail(p.where,
+           "unknown point name " + quote(p.name) + "; the closest known names are " +
+               join_quoted(closest_names(p.name, known_names, 3)) +
+               "; use a landmark, a landmarks.points name, '<muscle>.insertion' or '<muscle>.origin', "
+               "or coordinates [x, y, z]");
+    }
+    p.xyz = it->second;
+    p.resolved = true;
+  };
+
+  std::vector<std::string> muscle_names;
+  for (const MuscleLine& m : landmarks.muscles) muscle_names.push_back(m.name);
+  for (Muscle& m : s.muscles) {
+    const auto line = std::find_if(landmarks.muscles.begin(), landmarks.muscles.end(),
+                                   [&](const MuscleLine& l) { return l.name == m.name; });
+    const bool uses_defaults = (!m.insertion.resolved && m.insertion.name == m.name + ".insertion") ||
+                               (m.origin && !m.origin->resolved && m.origin->name == m.name + ".origin") ||
+                               !m.max_force_N;
+    if (line == landmarks.muscles.end() && uses_defaults)
+      fail(m.where,
+           "muscle " + quote(m.name) + " is not a muscle of the landmarks" +
+               (muscle_names.empty()
+                    ? " (they have none)"
+                    : " (closest: " + join_quoted(closest_names(m.name, muscle_names, 3)) + ")") +
+               ", so its insertion, origin and max_force_N have no default; correct the name or give all "
+               "three ('direction' may replace 'origin')");
+    if (!m.max_force_N) m.max_force_N = line->max_force_N;
+    resolve(m.insertion);
+    Vec3 d;
+    if (m.origin) {
+      resolve(*m.origin);
+      for (int k = 0; k < 3; ++k) d[k] = m.origin->xyz[k] - m.insertion.xyz[k];
+    } else {
+      d = *m.direction;
+    }
+    const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (length < 1e-9)
+      fail(m.origin ? m.origin->where : m.where,
+           "muscle " + quote(m.name) + " has a zero line of action: its origin equals its insertion " +
+               fmt(m.insertion.xyz) + "; move the origin or give 'direction: [x, y, z]' instead");
+    for (int k = 0; k < 3; ++k) m.line_of_action[k] = d[k] / length;
+  }
+  for (Support& support : s.supports) resolve(support.at);
+  for (Probe& probe : s.probes) resolve(probe.at);
+  for (MaterialRegion& region : s.materials.regions) {
+    if (region.shape == RegionShape::kSphere) {
+      resolve(region.center);
+      continue;
+    }
+    resolve(region.min);
+    resolve(region.max);
+    for (int k = 0; k < 3; ++k)
+      if (region.min.xyz[k] >= region.max.xyz[k])
+        fail(region.where, "material region " + quote(region.name) + ": box min " + fmt(region.min.xyz) +
+                               " is not below max " + fmt(region.max.xyz) + " in " + "xyz"[k] +
+                               "; min must be the lower corner and max the upper one");
+  }
+}
+
+Material material_at(const Materials& materials, const Vec3& x) {
+  for (auto it = materials.regions.rbegin(); it != materials.regions.rend(); ++it) {
+    const MaterialRegion& r = *it;
+    const bool inside = r.shape == RegionShape::kSphere
+                            ? distance(x, r.center.xyz) <= r.radius_mm
+                            : (x[0] >= r.min.xyz[0] && x[0] <= r.max.xyz[0] && x[1] >= r.min.xyz[1] &&
+                               x[1] <= r.max.xyz[1] && x[2] >= r.min.xyz[2] && x[2] <= r.max.xyz[2]);
+    if (inside) return r.material;
+  }
+  return materials.default_material;
+}
+
+Vec3 muscle_force(const Muscle& muscle) {
+  const double magnitude = muscle.activation * muscle.max_force_N.value_or(0);
+  return {magnitude * muscle.line_of_action[0], magnitude * muscle.line_of_action[1],
+          magnitude * muscle.line_of_action[2]};
+}
+
+std::vector<int> select_patch_quads(const QuadSurface& boundary, const Vec3& center, double radius) {
+  std::vector<int> selected;
+  for (size_t q = 0; q < boundary.quads.size(); ++q)
+    if (distance(quad_centroid(boundary, boundary.quads[q]), center) <= radius)
+      selected.push_back(static_cast<int>(q));
+  return selected;
+}
+
+std::vector<int> require_patch_quads(const QuadSurface& boundary, const Vec3& center, double radius,
+                                     const SourceLocation& where, const std::string& what) {
+  std::vector<int> selected = select_patch_quads(boundary, center, radius);
+  if (!selected.empty()) return selected;
+  if (boundary.quads.empty())
+    fail(where, what + " selects no surface facets because the mesh boundary has none");
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& quad : boundary.quads)
+    nearest = std::min(nearest, distance(quad_centroid(boundary, quad), center));
+  fail(where, what + " selects no surface facets: no boundary facet centre lies within radius_mm = " +
+                  fmt(radius) + " of " + fmt(center) + ", the nearest is " + fmt(nearest) +
+                  " mm away; increase radius_mm beyond that, move the point onto the bone surface, or refine "
+                  "the mesh");
+}
+
+}  // namespace hexbite

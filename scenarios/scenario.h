@@ -1,0 +1,179 @@
+// Scenario files: what to simulate (geometry, landmarks, mesh settings, materials, muscles, supports,
+// solver settings, outputs and probes), read from YAML with strict validation. The format is documented
+// key by key in docs/scenario-format.md; every error is an InputError "FILE:LINE:COLUMN: what is wrong;
+// what to do". Names used as points are kept unresolved by load_scenario() because the landmarks only
+// exist once the geometry is built; resolve_points() turns them into coordinates afterwards.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mesher/hex_mesh.h"
+#include "mesher/landmarks.h"
+#include "mesher/mandible_generator.h"
+#include "mesher/tri_surface.h"
+
+namespace hexbite {
+
+// Where something was written in a scenario file; line and column count from 1.
+struct SourceLocation {
+  std::string file;  // the scenario path as given to load_scenario()
+  int line = 0;
+  int column = 0;
+
+  std::string str() const;  // "FILE:LINE:COLUMN", the prefix of every scenario error message
+};
+
+// A point in millimetres, written either as coordinates [x, y, z] or as a name: a landmark, an extra
+// point of the scenario's landmarks.points, or "<muscle>.insertion" / "<muscle>.origin".
+struct PointRef {
+  std::string name;  // empty when the point was given as coordinates
+  Vec3 xyz{};        // the coordinates: as written, or filled in by resolve_points()
+  bool resolved = false;
+  SourceLocation where;
+};
+
+enum class GeometrySource { kMandible, kSurface, kCt };
+
+struct GeometrySpec {
+  GeometrySource source = GeometrySource::kMandible;
+  MandibleParameters mandible;  // kMandible: zero fields mean the variant's defaults (complete_parameters)
+  std::string file;             // kSurface, kCt: resolved against the scenario file's folder
+  std::string units = "mm";     // kSurface: the file's length unit
+  double scale_to_mm = 1.0;     // kSurface: unit_to_mm(units)
+  double threshold = 0;         // kCt: the iso-value of the bone surface
+  SourceLocation where;
+};
+
+struct NamedPoint {
+  std::string name;
+  Vec3 xyz{};
+  SourceLocation where;
+};
+
+struct LandmarkSpec {
+  std::string file;          // empty: the built-in mandible's own landmarks (or none for other geometry)
+  double scale_to_mm = 1.0;  // the landmark file's unit; defaults to the surface's unit
+  std::vector<NamedPoint> points;  // extra named points (mm), usable wherever a point is expected
+  SourceLocation where;
+};
+
+enum class MeshMethod { kGrid, kSheets };
+
+struct MeshSettings {
+  MeshMethod method = MeshMethod::kGrid;
+  int target_hexes = 2500;
+  int validation_levels = 1;  // each level is one 8-way refinement solved again
+};
+
+struct Material {
+  double E_MPa = 11000;
+  double poisson = 0.28;
+};
+
+enum class RegionShape { kSphere, kBox };
+
+// A part of the bone with another material, e.g. an implant site or a resorbed region.
+struct MaterialRegion {
+  std::string name;
+  RegionShape shape = RegionShape::kSphere;
+  PointRef center;  // kSphere
+  double radius_mm = 0;
+  PointRef min, max;  // kBox: opposite corners, min below max in every coordinate
+  Material material;
+  SourceLocation where;
+};
+
+struct Materials {
+  Material default_material;
+  std::vector<MaterialRegion> regions;  // where regions overlap, the later one in the file wins
+};
+
+struct Muscle {
+  std::string name;
+  PointRef insertion;  // centre of the insertion patch; default "<name>.insertion"
+  double radius_mm = 10;
+  // The line of action: toward `origin` (default "<name>.origin") or along `direction` (exactly one).
+  std::optional<PointRef> origin;
+  std::optional<Vec3> direction;      // as written; never zero
+  std::optional<double> max_force_N;  // empty until resolve_points() takes it from the landmarks
+  double activation = 0;
+  Vec3 line_of_action{};  // unit vector, filled in by resolve_points()
+  SourceLocation where;
+};
+
+struct Support {
+  std::string name;
+  PointRef at;  // centre of the support patch
+  double radius_mm = 0;
+  std::array<bool, 3> fixed{true, true, true};  // fixed displacement components x, y, z
+  std::optional<double> spring_N_per_mm3;       // an elastic foundation instead of fixed components
+  bool bite = false;  // the bite force is the magnitude of the summed reaction of the bite supports
+  SourceLocation where;
+};
+
+enum class LinearSolver { kAuto, kCgAmg, kDirect };
+
+struct SolverSettings {
+  int degree = 1;
+  LinearSolver linear_solver = LinearSolver::kAuto;
+  double tolerance = 1e-10;  // relative residual
+  int max_iterations = 10000;
+};
+
+struct Outputs {
+  bool vtu = true;
+  bool inp = false;
+  bool bite_force = true;  // report bite_force_N; requires at least one bite support
+};
+
+struct Probe {
+  std::string name;
+  PointRef at;
+  SourceLocation where;
+};
+
+struct Scenario {
+  std::string path;  // the scenario file as given
+  int format_version = 1;
+  std::string name;
+  std::string description;
+  GeometrySpec geometry;
+  LandmarkSpec landmarks;
+  MeshSettings mesh;
+  Materials materials;
+  std::vector<Muscle> muscles;  // the explicit list first, then the activation_pattern's muscles
+  std::vector<Support> supports;
+  SolverSettings solver;
+  Outputs outputs;
+  std::vector<Probe> probes;
+};
+
+// Reads and validates a scenario file. Everything that can be checked without the geometry is checked
+// here (keys, types, ranges, duplicate names, supports); throws InputError "FILE:LINE:COLUMN: ...".
+Scenario load_scenario(const std::string& path);
+
+// Turns every named point into coordinates using `landmarks` and the scenario's extra points, fills in
+// the muscles' defaults from the landmarks (insertion, origin, max_force_N) and their unit lines of
+// action. Throws InputError at the name's file and line, listing the closest known names, for an unknown
+// name, a muscle the landmarks do not know, a zero line of action or a box with min not below max.
+// Calling it again is harmless.
+void resolve_points(Scenario& scenario, const Landmarks& landmarks);
+
+// The material at a point (after resolve_points): the last region containing it, else the default.
+Material material_at(const Materials& materials, const Vec3& x);
+
+// A muscle's force vector in N (after resolve_points): activation x max force along the line of action.
+Vec3 muscle_force(const Muscle& muscle);
+
+// The boundary quads of a patch: those whose centroid lies within `radius` of `center` (sorted indices).
+std::vector<int> select_patch_quads(const QuadSurface& boundary, const Vec3& center, double radius);
+
+// select_patch_quads(), but a patch that selects no surface facet is an InputError at `where` (the
+// scenario entry of the muscle, support or region) that names `what` and says how far the nearest facet is.
+std::vector<int> require_patch_quads(const QuadSurface& boundary, const Vec3& center, double radius,
+                                     const SourceLocation& where, const std::string& what);
+
+}  // namespace hexbite

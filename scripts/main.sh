@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# One command for the main job: installs the packages, builds, and runs the default job on the
+# built-in procedural mandible. Outputs go to out/ (or the folder given as the first argument).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+scripts/build.sh
+out=${1:-out}
+mkdir -p "$out"
+hexbite=${HEXBITE_BUILD_DIR:-build}/app/hexbite
+"$hexbite" generate mandible -o "$out/jaw.stl" --landmarks "$out/jaw.landmarks.yaml" --ct "$out/jaw.mha"
+"$hexbite" surface check "$out/jaw.stl"
+"$hexbite" surface clean "$out/jaw.stl" -o "$out/jaw_clean.stl"
+echo "main: outputs in $out/"

@@ -1,0 +1,404 @@
+// Hex mesh files (VTU, INP, MSH), boundary extraction and the `hexbite quality` command.
+#include <gtest/gtest.h>
+#include <vtkCellArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "common/error.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
+#include "postprocess/quality_json.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+using test::read_file;
+using test::run_hexbite;
+using test::temp_dir;
+using test::write_file;
+
+// An nx x ny x nz block of unit cubes, vertices numbered x fastest.
+HexMesh block(int nx, int ny, int nz) {
+  HexMesh mesh;
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({double(i), double(j), double(k)});
+  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                              id(i, j + 1, k + 1)});
+  return mesh;
+}
+
+// The block with every vertex moved by up to 0.2 and values that do not round-trip through short decimals.
+HexMesh perturbed_block(int nx, int ny, int nz) {
+  HexMesh mesh = block(nx, ny, nz);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (Vec3& p : mesh.vertices)
+    for (double& c : p) c = c * 1.1 + u(rng) / 3.0;
+  return mesh;
+}
+
+template <typename F>
+std::string input_error_of(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an InputError";
+  return "";
+}
+
+const MeshArray* find_array(const std::vector<MeshArray>& arrays, const std::string& name) {
+  for (const MeshArray& a : arrays)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+TEST(HexMeshIo, VtuRoundTripWithArrays) {
+  const HexMesh mesh = perturbed_block(3, 2, 2);
+  MeshArray material{"material", 1, {}};
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) material.values.push_back(double(h % 3));
+  MeshArray displacement{"displacement", 3, {}};
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    for (int d = 0; d < 3; ++d) displacement.values.push_back(0.001 * v + d);
+
+  const std::string dir = temp_dir();
+  write_vtu(dir + "/a.vtu", mesh, {material}, {displacement});
+  std::vector<MeshArray> cells, points;
+  const HexMesh back = read_vtu(dir + "/a.vtu", &cells, &points);
+  EXPECT_EQ(back.vertices, mesh.vertices);  // doubles are stored exactly
+  EXPECT_EQ(back.hexes, mesh.hexes);
+
+  const HexQualityField q = compute_hex_quality(mesh);
+  ASSERT_NE(find_array(cells, "scaled_jacobian"), nullptr);
+  EXPECT_EQ(find_array(cells, "scaled_jacobian")->values, q.scaled_jacobian);
+  EXPECT_EQ(find_array(cells, "condition")->values, q.condition);
+  EXPECT_EQ(find_array(cells, "oddy")->values, q.oddy);
+  EXPECT_EQ(find_array(cells, "jacobian")->values, q.jacobian);
+  ASSERT_NE(find_array(cells, "material"), nullptr);
+  EXPECT_EQ(find_array(cells, "material")->values, material.values);
+  ASSERT_NE(find_array(points, "displacement"), nullptr);
+  EXPECT_EQ(find_array(points, "displacement")->components, 3);
+  EXPECT_EQ(find_array(points, "displacement")->values, displacement.values);
+
+  // Deterministic bytes, and no temporary file left behind.
+  write_vtu(dir + "/b.vtu", mesh, {material}, {displacement});
+  EXPECT_EQ(read_file(dir + "/a.vtu"), read_file(dir + "/b.vtu"));
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file();
+  EXPECT_EQ(files, 2);
+}
+
+TEST(HexMeshIo, VtuRejectsBadArrays) {
+  const HexMesh mesh = block(1, 1, 1);
+  const std::string path = temp_dir() + "/bad.vtu";
+  EXPECT_THROW(write_vtu(path, mesh, {{"condition", 1, {1.0}}}), std::invalid_argument);
+  EXPECT_THROW(write_vtu(path, mesh, {{"material", 1, {1.0, 2.0}}}), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(path));
+}
+
+// A hand-written ASCII VTU file with the given cell type, connectivity, offsets and point coordinates.
+std::string ascii_vtu(int cells, const std::string& types, const std::string& connectivity,
+                      const std::string& offsets, const std::string& points, int num_points) {
+  std::ostringstream s;
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+       "byte_order=\"LittleEndian\">\n"
+    << "<UnstructuredGrid><Piece NumberOfPoints=\"" << num_points << "\" NumberOfCells=\"" << cells << "\">\n"
+    << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">" << points
+    << "</DataArray></Points>\n<Cells>\n"
+    << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">" << connectivity << "</DataArray>\n"
+    << "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">" << offsets << "</DataArray>\n"
+    << "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">" << types << "</DataArray>\n"
+    << "</Cells></Piece></UnstructuredGrid></VTKFile>\n";
+  return s.str();
+}
+
+const char* kCubePoints = "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1";
+
+TEST(HexMeshIo, VtuReaderErrors) {
+  const std::string dir = temp_dir();
+  // A hand-written valid file reads, which shows that the error cases below fail for their own reason.
+  write_file(dir + "/ok.vtu", ascii_vtu(1, "12", "0 1 2 3 4 5 6 7", "8", kCubePoints, 8));
+  EXPECT_EQ(read_vtu(dir + "/ok.vtu").hexes.size(), 1u);
+
+  std::string msg = input_error_of([&] { read_vtu(dir + "/missing.vtu"); });
+  EXPECT_NE(msg.find("missing.vtu"), std::string::npos);
+  EXPECT_NE(msg.find("does not exist"), std::string::npos);
+
+  write_file(dir + "/garbage.vtu", "this is not a mesh\n\x01\x02\x03");
+  msg = input_error_of([&] { read_vtu(dir + "/garbage.vtu"); });
+  EXPECT_NE(msg.find("garbage.vtu"), std::string::npos);
+  EXPECT_NE(msg.find("not a VTK XML unstructured grid"), std::string::npos);
+
+  write_file(dir + "/empty.vtu", "");
+  EXPECT_NE(input_error_of([&] { read_vtu(dir + "/empty.vtu"); }).find("empty"), std::string::npos);
+
+  write_file(dir + "/tetra.vtu", ascii_vtu(2, "12 10", "0 1 2 3 4 5 6 7 0 1 3 4", "8 12", kCubePoints, 8));
+  msg = input_error_of([&] { read_vtu(dir + "/tetra.vtu"); });
+  EXPECT_NE(msg.find("cell 1 is a vtkTetra"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("type 10"), std::string::npos) << msg;
+
+  write_file(dir + "/range.vtu", ascii_vtu(1, "12", "0 1 2 3 4 5 6 9", "8", kCubePoints, 8));
+  msg = input_error_of([&] { read_vtu(dir + "/range.vtu"); });
+  EXPECT_NE(msg.find("vertex 9"), std::string::npos) << msg;
+
+  write_file(dir + "/nan.vtu", ascii_vtu(1, "12", "0 1 2 3 4 5 6 7", "8",
+                                         "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 nan 1 0 1 1", 8));
+  msg = input_error_of([&] { read_vtu(dir + "/nan.vtu"); });
+  EXPECT_NE(msg.find("vertex 6"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("NaN"), std::string::npos) << msg;
+
+  // A truncated binary file: the header promises data that is not there.
+  write_vtu(dir + "/full.vtu", block(2, 2, 2));
+  const std::string full = read_file(dir + "/full.vtu");
+  write_file(dir + "/truncated.vtu", full.substr(0, full.size() / 2));
+  msg = input_error_of([&] { read_vtu(dir + "/truncated.vtu"); });
+  EXPECT_NE(msg.find("truncated.vtu"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("damaged or truncated"), std::string::npos) << msg;
+}
+
+// Parses the *NODE, *ELEMENT and set blocks of an .inp file written by write_inp.
+struct ParsedInp {
+  std::vector<Vec3> nodes;
+  std::vector<std::array<int, 8>> elements;
+  std::map<std::string, std::vector<int>> sets;  // keyword "NSET:name" / "ELSET:name" -> 1-based ids
+  std::string element_type;
+};
+
+ParsedInp parse_inp(const std::string& text) {
+  ParsedInp p;
+  std::istringstream in(text);
+  std::string line, block;
+  while (std::getline(in, line)) {
+    if (line.rfind("**", 0) == 0) continue;
+    if (line[0] == '*') {
+      if (line.rfind("*NODE", 0) == 0)
+        block = "NODE";
+      else if (line.rfind("*ELEMENT", 0) == 0) {
+        block = "ELEMENT";
+        p.element_type = line.substr(line.find("TYPE=") + 5, 4);
+      } else {
+        const auto eq = line.find('=');
+        block = line.substr(1, line.find(',') - 1) + ":" + line.substr(eq + 1);
+      }
+      continue;
+    }
+    for (char& c : line)
+      if (c == ',') c = ' ';
+    std::istringstream s(line);
+    if (block == "NODE") {
+      int id;
+      Vec3 x;
+      s >> id >> x[0] >> x[1] >> x[2];
+      EXPECT_EQ(id, static_cast<int>(p.nodes.size()) + 1);
+      p.nodes.push_back(x);
+    } else if (block == "ELEMENT") {
+      int id;
+      std::array<int, 8> e;
+      s >> id;
+      for (int& v : e) {
+        s >> v;
+        --v;
+      }
+      p.elements.push_back(e);
+    } else {
+      int id;
+      int count = 0;
+      while (s >> id) {
+        p.sets[block].push_back(id);
+        ++count;
+      }
+      EXPECT_LE(count, 16);
+    }
+  }
+  return p;
+}
+
+TEST(HexMeshIo, InpExport) {
+  const HexMesh mesh = perturbed_block(3, 2, 2);
+  IndexSet bottom{"BOTTOM", {}};
+  for (int v = 0; v < 12; ++v) bottom.ids.push_back(v);  // the z = 0 layer: 4 x 3 vertices
+  IndexSet left{"left_cells", {0, 3, 6, 9}};
+  const std::string path = temp_dir() + "/m.inp";
+  write_inp(path, mesh, {bottom, {"many", std::vector<int>(40, 1)}}, {left});
+  const ParsedInp p = parse_inp(read_file(path));
+  EXPECT_EQ(p.element_type, "C3D8");
+  EXPECT_EQ(p.nodes, mesh.vertices);
+  EXPECT_EQ(p.elements, mesh.hexes);
+  std::vector<int> bottom_1based;
+  for (int v : bottom.ids) bottom_1based.push_back(v + 1);
+  EXPECT_EQ(p.sets.at("NSET:BOTTOM"), bottom_1based);
+  EXPECT_EQ(p.sets.at("ELSET:left_cells"), (std::vector<int>{1, 4, 7, 10}));
+  EXPECT_EQ(p.sets.at("NSET:many").size(), 40u);
+
+  EXPECT_THROW(write_inp(path, mesh, {{"1bad", {0}}}), std::invalid_argument);
+  EXPECT_THROW(write_inp(path, mesh, {{"nall", {0}}}), std::invalid_argument);
+  EXPECT_THROW(write_inp(path, mesh, {}, {{"E", {12}}}), std::invalid_argument);
+}
+
+TEST(HexMeshIo, MshRoundTrip) {
+  const HexMesh mesh = perturbed_block(3, 2, 2);
+  const std::string dir = temp_dir();
+  write_msh(dir + "/m.msh", mesh);
+  const HexMesh back = read_msh(dir + "/m.msh");
+  EXPECT_EQ(back.vertices, mesh.vertices);
+  EXPECT_EQ(back.hexes, mesh.hexes);
+  write_msh(dir + "/n.msh", mesh);
+  EXPECT_EQ(read_file(dir + "/m.msh"), read_file(dir + "/n.msh"));
+}
+
+TEST(HexMeshIo, MshVersion22WithLowerDimensionalElements) {
+  const std::string dir = temp_dir();
+  // Gmsh writes boundary quads and points beside the hexes; node tags need not be contiguous.
+  write_file(dir + "/v22.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n"
+             "10 0 0 0\n11 1 0 0\n12 1 1 0\n13 0 1 0\n14 0 0 1\n15 1 0 1\n16 1 1 1\n17 0 1 1\n$EndNodes\n"
+             "$Elements\n3\n1 15 2 0 1 10\n2 3 2 0 1 10 13 12 11\n3 5 2 1 1 10 11 12 13 14 15 16 "
+             "17\n$EndElements\n");
+  const HexMesh m = read_msh(dir + "/v22.msh");
+  ASSERT_EQ(m.hexes.size(), 1u);
+  EXPECT_EQ(m.hexes[0], (std::array<int, 8>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(hex_quality(m.vertices.data()).scaled_jacobian, 1.0);
+
+  write_file(
+      dir + "/tet.msh",
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+      "$Elements\n1\n7 4 2 0 1 1 2 3 4\n$EndElements\n");
+  std::string msg = input_error_of([&] { read_msh(dir + "/tet.msh"); });
+  EXPECT_NE(msg.find("element 7"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("line 13"), std::string::npos) << msg;
+
+  write_file(dir + "/junk.msh", "hello\n");
+  EXPECT_NE(input_error_of([&] { read_msh(dir + "/junk.msh"); }).find("not a Gmsh"), std::string::npos);
+}
+
+// Area vector of a planar or nearly planar quad: half the cross product of its diagonals.
+Vec3 area_vector(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 p{c[0] - a[0], c[1] - a[1], c[2] - a[2]}, q{d[0] - b[0], d[1] - b[1], d[2] - b[2]};
+  return {0.5 * (p[1] * q[2] - p[2] * q[1]), 0.5 * (p[2] * q[0] - p[0] * q[2]),
+          0.5 * (p[0] * q[1] - p[1] * q[0])};
+}
+
+TEST(HexBoundary, BlockThreeByTwoByTwo) {
+  const HexMesh mesh = block(3, 2, 2);
+  const HexBoundary b = extract_boundary(mesh);
+  // 2 (3x2) + 2 (3x2) + 2 (2x2) faces.
+  ASSERT_EQ(b.surface.quads.size(), 32u);
+  ASSERT_EQ(b.quad_face.size(), 32u);
+  // All vertices but the 2 interior ones (1,1,1) and (2,1,1) are on the boundary.
+  EXPECT_EQ(b.boundary_vertices.size(), mesh.vertices.size() - 2);
+
+  // Outward orientation by the divergence theorem: the sum over the quads of (area vector)_x times the
+  // centroid's x is the volume, 12; the same for y and z.
+  double flux[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < b.surface.quads.size(); ++i) {
+    const auto& q = b.surface.quads[i];
+    const Vec3 &p0 = b.surface.vertices[q[0]], &p1 = b.surface.vertices[q[1]], &p2 = b.surface.vertices[q[2]],
+               &p3 = b.surface.vertices[q[3]];
+    const Vec3 n = area_vector(p0, p1, p2, p3);
+    for (int d = 0; d < 3; ++d) flux[d] += n[d] * 0.25 * (p0[d] + p1[d] + p2[d] + p3[d]);
+    // The map back to the hex face gives the same vertices.
+    const auto [h, f] = b.quad_face[i];
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(b.boundary_vertices[q[k]], mesh.hexes[h][kHexFaces[f][k]]);
+  }
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(flux[d], 12.0, 1e-12);
+
+  // Every face that is not on the boundary is shared by exactly two hexes.
+  std::map<std::array<int, 4>, int> uses;
+  for (const auto& hex : mesh.hexes)
+    for (const auto& f : kHexFaces) {
+      std::array<int, 4> key{hex[f[0]], hex[f[1]], hex[f[2]], hex[f[3]]};
+      std::sort(key.begin(), key.end());
+      ++uses[key];
+    }
+  int interior = 0, boundary = 0;
+  for (const auto& [key, count] : uses) {
+    EXPECT_LE(count, 2);
+    (count == 2 ? interior : boundary) += 1;
+  }
+  EXPECT_EQ(boundary, 32);
+  EXPECT_EQ(interior, 20);  // (12 x 6 - 32) / 2
+
+  const std::vector<char> mask = boundary_vertex_mask(mesh);
+  int on = 0;
+  for (char c : mask) on += c;
+  EXPECT_EQ(on, static_cast<int>(b.boundary_vertices.size()));
+}
+
+TEST(HexBoundary, NonManifoldFaceIsAnError) {
+  HexMesh mesh = block(1, 1, 1);
+  mesh.hexes.push_back(mesh.hexes[0]);
+  mesh.hexes.push_back(mesh.hexes[0]);
+  const std::string msg = input_error_of([&] { extract_boundary(mesh); });
+  EXPECT_NE(msg.find("shared by 3 hexes (0, 1, 2)"), std::string::npos) << msg;
+}
+
+TEST(QualityCommand, JsonMatchesLibrary) {
+  HexMesh mesh = perturbed_block(4, 3, 3);
+  mesh.vertices[mesh.hexes[0][6]] = {0.5, 0.5, 0.5};  // one inverted hex at least
+  const std::string path = temp_dir() + "/q.vtu";
+  write_vtu(path, mesh);
+  const test::CommandResult r = run_hexbite({"quality", path, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const QualitySummary s = summarize_quality(read_vtu(path));
+  EXPECT_EQ(j, quality_to_json(s));
+  EXPECT_EQ(j["hexes"], 36);
+  EXPECT_EQ(j["nodes"], 80);
+  EXPECT_GE(j["inverted"].get<int>(), 1);
+  for (const char* key : {"scaled_jacobian", "condition", "condition_verdict", "oddy"})
+    for (const char* stat : {"min", "mean", "max"})
+      EXPECT_TRUE(j[key][stat].is_number()) << key << ' ' << stat;
+  EXPECT_DOUBLE_EQ(j["scaled_jacobian"]["min"].get<double>(), s.scaled_jacobian.min);
+  EXPECT_DOUBLE_EQ(j["condition"]["max"].get<double>(), s.condition.max);
+  EXPECT_DOUBLE_EQ(j["condition_verdict"]["mean"].get<double>(), s.condition.mean / 3.0);
+  EXPECT_EQ(j["node_degree"]["edges"]["max"], s.node_degree.max_edges);
+
+  const test::CommandResult table = run_hexbite({"quality", path});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  for (const char* row :
+       {"scaled Jacobian", "condition number (cube = 3)", "condition number (Verdict, cube = 1)", "Oddy",
+        "inverted elements:", "node degree"})
+    EXPECT_NE(table.out.find(row), std::string::npos) << row << "\n" << table.out;
+}
+
+TEST(QualityCommand, BadInputExitsTwo) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/tetra.vtu", ascii_vtu(1, "10", "0 1 3 4", "4", kCubePoints, 8));
+  write_file(dir + "/garbage.vtu",
+             "\x7f"
+             "ELF garbage");
+  const std::pair<std::string, std::string> cases[] = {
+      {dir + "/missing.vtu", "does not exist"},
+      {dir + "/tetra.vtu", "cell 0 is a vtkTetra"},
+      {dir + "/garbage.vtu", "not a VTK XML unstructured grid"}};
+  for (const auto& [path, expected] : cases) {
+    const test::CommandResult r = run_hexbite({"quality", path});
+    EXPECT_EQ(r.exit_code, 2) << path;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace hexbite

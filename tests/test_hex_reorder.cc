@@ -1,0 +1,227 @@
+// Breadth-first and reverse Cuthill-McKee reordering (mesher/hex_reorder.h) and the `hexbite reorder`
+// command.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+
+#include "mesher/grid_mesher.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_mesh_io.h"
+#include "mesher/hex_reorder.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+using test::run_hexbite;
+using test::temp_dir;
+
+// An nx x ny x nz block of unit cubes, vertices numbered x fastest.
+HexMesh block(int nx, int ny, int nz) {
+  HexMesh mesh;
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({double(i), double(j), double(k)});
+  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                              id(i, j + 1, k + 1)});
+  return mesh;
+}
+
+// The block with its nodes and hexes randomly renumbered (a fixed seed): the worst case for bandwidth.
+HexMesh shuffled(const HexMesh& mesh, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<int> node(mesh.vertices.size()), hex(mesh.hexes.size());
+  for (std::size_t i = 0; i < node.size(); ++i) node[i] = static_cast<int>(i);
+  for (std::size_t i = 0; i < hex.size(); ++i) hex[i] = static_cast<int>(i);
+  std::shuffle(node.begin(), node.end(), rng);
+  std::shuffle(hex.begin(), hex.end(), rng);
+  HexMesh out;
+  out.vertices.resize(mesh.vertices.size());
+  for (std::size_t v = 0; v < node.size(); ++v) out.vertices[node[v]] = mesh.vertices[v];
+  for (int h : hex) {
+    std::array<int, 8> e;
+    for (int k = 0; k < 8; ++k) e[k] = node[mesh.hexes[h][k]];
+    out.hexes.push_back(e);
+  }
+  return out;
+}
+
+// Bandwidth and profile from the explicit set of adjacent node pairs, independent of the library's per-hex
+// shortcut.
+AdjacencyProfile brute_force_profile(const HexMesh& mesh) {
+  std::set<std::pair<int, int>> pairs;
+  for (const auto& hex : mesh.hexes)
+    for (int a : hex)
+      for (int b : hex) pairs.insert({a, b});
+  AdjacencyProfile p;
+  std::vector<int> lowest(mesh.vertices.size());
+  for (std::size_t v = 0; v < lowest.size(); ++v) lowest[v] = static_cast<int>(v);
+  for (const auto& [a, b] : pairs) {
+    p.bandwidth = std::max<long long>(p.bandwidth, std::abs(a - b));
+    lowest[a] = std::min(lowest[a], b);
+  }
+  for (std::size_t v = 0; v < lowest.size(); ++v) p.profile += static_cast<long long>(v) - lowest[v];
+  return p;
+}
+
+// Checks that `r` renumbers `mesh`: both orders are permutations, and each new hex is its old hex with the
+// same corner positions in the same order.
+void expect_permutation(const HexMesh& mesh, const ReorderResult& r) {
+  ASSERT_EQ(r.hex_order.size(), mesh.hexes.size());
+  ASSERT_EQ(r.node_order.size(), mesh.vertices.size());
+  std::vector<int> h = r.hex_order, n = r.node_order;
+  std::sort(h.begin(), h.end());
+  std::sort(n.begin(), n.end());
+  for (std::size_t i = 0; i < h.size(); ++i) ASSERT_EQ(h[i], static_cast<int>(i));
+  for (std::size_t i = 0; i < n.size(); ++i) ASSERT_EQ(n[i], static_cast<int>(i));
+  for (std::size_t i = 0; i < r.node_order.size(); ++i)
+    ASSERT_EQ(r.mesh.vertices[i], mesh.vertices[r.node_order[i]]);
+  for (std::size_t i = 0; i < r.hex_order.size(); ++i)
+    for (int k = 0; k < 8; ++k)
+      ASSERT_EQ(r.mesh.vertices[r.mesh.hexes[i][k]], mesh.vertices[mesh.hexes[r.hex_order[i]][k]]);
+  EXPECT_DOUBLE_EQ(hex_mesh_volume(r.mesh), hex_mesh_volume(mesh));
+}
+
+TEST(HexReorder, BothMethodsArePermutations) {
+  const HexMesh mesh = shuffled(block(6, 5, 4), 11);
+  expect_permutation(mesh, reorder_breadth_first(mesh, 17));
+  expect_permutation(mesh, reorder_reverse_cuthill_mckee(mesh));
+}
+
+TEST(HexReorder, UnusedNodesGoLast) {
+  HexMesh mesh = block(2, 2, 2);
+  mesh.vertices.insert(mesh.vertices.begin() + 3, Vec3{9, 9, 9});
+  for (auto& hex : mesh.hexes)
+    for (int& v : hex)
+      if (v >= 3) ++v;
+  for (const ReorderResult& r : {reorder_breadth_first(mesh, 0), reorder_reverse_cuthill_mckee(mesh)}) {
+    expect_permutation(mesh, r);
+    EXPECT_EQ(r.node_order.back(), 3);
+  }
+}
+
+TEST(HexReorder, ReverseCuthillMcKeeShrinksTheBandwidthOfAShuffledBlock) {
+  // An elongated block, like a mandible: Cuthill-McKee's level sets are then cross-sections (6 x 7 x 7 nodes
+  // at most two levels apart), while random numbering spreads neighbours over the whole range.
+  const HexMesh mesh = shuffled(block(30, 6, 6), 5);
+  const ReorderResult r = reorder_reverse_cuthill_mckee(mesh);
+  expect_permutation(mesh, r);
+  EXPECT_GT(r.before.bandwidth, 1400);
+  EXPECT_LT(r.after.bandwidth, 150);
+  EXPECT_GE(r.before.bandwidth, 10 * r.after.bandwidth);
+  EXPECT_GE(r.before.profile, 10 * r.after.profile);
+  // Breadth-first over hexes from one end also orders the block by cross-sections.
+  const ReorderResult b = reorder_breadth_first(mesh, smallest_x_boundary_hex(mesh));
+  EXPECT_GE(b.before.bandwidth, 5 * b.after.bandwidth);
+}
+
+TEST(HexReorder, ReportedBandwidthEqualsBruteForce) {
+  const HexMesh mesh = shuffled(block(5, 4, 3), 2);
+  const ReorderResult r = reorder_reverse_cuthill_mckee(mesh);
+  const AdjacencyProfile before = brute_force_profile(mesh), after = brute_force_profile(r.mesh);
+  EXPECT_EQ(r.before.bandwidth, before.bandwidth);
+  EXPECT_EQ(r.before.profile, before.profile);
+  EXPECT_EQ(r.after.bandwidth, after.bandwidth);
+  EXPECT_EQ(r.after.profile, after.profile);
+  const ReorderResult b = reorder_breadth_first(mesh, 0);
+  EXPECT_EQ(b.after.bandwidth, brute_force_profile(b.mesh).bandwidth);
+  EXPECT_EQ(b.after.profile, brute_force_profile(b.mesh).profile);
+}
+
+TEST(HexReorder, BreadthFirstStartsAtTheBoundaryHexNearestThePoint) {
+  const HexMesh mesh = shuffled(block(6, 6, 6), 9);
+  // Boundary hexes by brute force: a hex with a face whose vertex set no other hex shares.
+  std::vector<char> boundary(mesh.hexes.size(), 0);
+  for (const auto& qf : extract_boundary(mesh).quad_face) boundary[qf[0]] = 1;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> coord(-2.0, 8.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Vec3 p{coord(rng), coord(rng), coord(rng)};
+    int expected = -1;
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+      if (!boundary[h]) continue;
+      Vec3 c{0, 0, 0};
+      for (int v : mesh.hexes[h])
+        for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8;
+      const double d = std::hypot(c[0] - p[0], c[1] - p[1], c[2] - p[2]);
+      if (d < best - 1e-12) {
+        best = d;
+        expected = static_cast<int>(h);
+      }
+    }
+    const int start = nearest_boundary_hex(mesh, p);
+    ASSERT_EQ(start, expected);
+    const ReorderResult r = reorder_breadth_first(mesh, start);
+    EXPECT_EQ(r.start_hex, start);
+    EXPECT_EQ(r.hex_order[0], start);
+    // The start hex's nodes come first.
+    for (int k = 0; k < 8; ++k) EXPECT_LT(r.mesh.hexes[0][k], 8);
+  }
+}
+
+TEST(HexReorder, Deterministic) {
+  const HexMesh mesh = shuffled(block(5, 5, 5), 4);
+  const ReorderResult a = reorder_reverse_cuthill_mckee(mesh), b = reorder_reverse_cuthill_mckee(mesh);
+  EXPECT_EQ(a.node_order, b.node_order);
+  EXPECT_EQ(a.hex_order, b.hex_order);
+}
+
+TEST(HexReorderCommand, ReordersAndReports) {
+  const std::string dir = temp_dir();
+  const HexMesh mesh = shuffled(block(6, 6, 6), 3);
+  write_vtu(dir + "/in.vtu", mesh);
+  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  const ReorderResult expected = reorder_reverse_cuthill_mckee(mesh);
+  EXPECT_EQ(j["before"]["bandwidth"], expected.before.bandwidth);
+  EXPECT_EQ(j["after"]["bandwidth"], expected.after.bandwidth);
+  EXPECT_EQ(j["after"]["profile"], expected.after.profile);
+  const HexMesh out = read_vtu(dir + "/rcm.vtu");
+  EXPECT_EQ(out.hexes, expected.mesh.hexes);
+  EXPECT_EQ(out.vertices, expected.mesh.vertices);
+
+  r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/bfs.vtu", "--method", "bfs", "--from", "6,6,6"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("bandwidth"), std::string::npos) << r.out;
+  const HexMesh bfs = read_vtu(dir + "/bfs.vtu");
+  EXPECT_EQ(bfs.hexes, reorder_breadth_first(mesh, nearest_boundary_hex(mesh, {6, 6, 6})).mesh.hexes);
+
+  test::write_file(dir + "/landmarks.yaml", "landmarks:\n  left_condyle_tmj_point: [0, 0, 0]\n");
+  r = run_hexbite(
+      {"reorder", dir + "/in.vtu", "-o", dir + "/lm.vtu", "--landmarks", dir + "/landmarks.yaml", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["start"]["hex"], nearest_boundary_hex(mesh, {0, 0, 0}));
+}
+
+TEST(HexReorderCommand, BadInput) {
+  const std::string dir = temp_dir();
+  write_vtu(dir + "/in.vtu", block(2, 2, 2));
+  EXPECT_EQ(run_hexbite({"reorder", dir + "/missing.vtu", "-o", dir + "/o.vtu"}).exit_code, 2);
+  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/o.vtu", "--from", "1,2"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("x,y,z"), std::string::npos) << r.err;
+  EXPECT_EQ(
+      run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/o.vtu", "--method", "rcm", "--from", "1,2,3"})
+          .exit_code,
+      2);
+  test::write_file(dir + "/landmarks.yaml", "landmarks:\n  menton: [0, 0, 0]\n");
+  r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/o.vtu", "--landmarks", dir + "/landmarks.yaml"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("left_condyle_tmj_point"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace hexbite

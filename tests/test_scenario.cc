@@ -1,0 +1,459 @@
+// Scenario files: the shipped scenarios load and resolve, every validation error names the file, the
+// line and the specific complaint, and patches select the right boundary facets.
+#include "scenarios/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "common/error.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Landmarks with the names the built-in mandible generator documents (mesher/mandible_generator.h):
+// distinct coordinates, so that a point resolved to the wrong name would show.
+Landmarks generator_landmarks() {
+  Landmarks l;
+  double offset = 0;
+  for (const char* side : {"left", "right"}) {
+    const double sign = std::string(side) == "left" ? 1 : -1;
+    for (const char* point :
+         {"condyle_tmj_point", "first_molar_bite_point", "premolar_bite_point", "coronoid_tip", "gonion"}) {
+      offset += 1;
+      l.points[std::string(side) + "_" + point] = {sign * (20 + offset), -offset, 40 + offset};
+    }
+  }
+  l.points["incisal_point"] = {0, -45, 45};
+  const std::pair<const char*, double> muscles[] = {
+      {"superficial_masseter", 190.4},      {"deep_masseter", 81.6},
+      {"medial_pterygoid", 174.8},          {"anterior_temporalis", 158.0},
+      {"middle_temporalis", 95.6},          {"posterior_temporalis", 75.6},
+      {"inferior_lateral_pterygoid", 66.9}, {"superior_lateral_pterygoid", 28.7},
+      {"anterior_digastric", 40.0}};
+  for (const char* side : {"left", "right"}) {
+    const double sign = std::string(side) == "left" ? 1 : -1;
+    for (const auto& [muscle, force] : muscles) {
+      offset += 1;
+      l.muscles.push_back(
+          {std::string(side) + "_" + muscle, force, {sign * 45, offset, 30}, {sign * 55, offset - 10, 80}});
+    }
+  }
+  return l;
+}
+
+std::string write_scenario(const std::string& text, const std::string& file_name = "bad.yaml") {
+  const std::string path = test::temp_dir() + "/" + file_name;
+  test::write_file(path, text);
+  return path;
+}
+
+// A valid scenario; the tests below change one thing in it. Line numbers are those of this text.
+const std::string kValid = R"(name: t
+geometry:
+  mandible: {variant: dentate}
+muscles:
+  - name: right_superficial_masseter
+    activation: 0.5
+supports:
+  - {name: nut, at: right_first_molar_bite_point, radius_mm: 4, bite: true}
+  - {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}
+  - {name: left_condyle, at: left_condyle_tmj_point, radius_mm: 6}
+)";
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// The message of the InputError that loading (and, with `resolve`, resolving) `text` throws.
+std::string error_of(const std::string& text, bool resolve = false) {
+  const std::string path = write_scenario(text);
+  try {
+    Scenario s = load_scenario(path);
+    if (resolve) resolve_points(s, generator_landmarks());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError for:\n" << text;
+  return "";
+}
+
+#define EXPECT_ERROR_AT(message, line, complaint)                                          \
+  do {                                                                                     \
+    const std::string m_ = (message);                                                      \
+    EXPECT_NE(m_.find("bad.yaml:" + std::to_string(line) + ":"), std::string::npos) << m_; \
+    EXPECT_NE(m_.find(complaint), std::string::npos) << m_;                                \
+  } while (0)
+
+TEST(Scenario, ValidBaseLoadsWithDefaults) {
+  Scenario s = load_scenario(write_scenario(kValid));
+  EXPECT_EQ(s.name, "t");
+  EXPECT_EQ(s.geometry.source, GeometrySource::kMandible);
+  EXPECT_EQ(s.mesh.method, MeshMethod::kGrid);
+  EXPECT_EQ(s.mesh.target_hexes, 2500);
+  EXPECT_EQ(s.mesh.validation_levels, 1);
+  EXPECT_EQ(s.materials.default_material.E_MPa, 11000);
+  EXPECT_EQ(s.materials.default_material.poisson, 0.28);
+  EXPECT_EQ(s.solver.degree, 1);
+  EXPECT_EQ(s.solver.linear_solver, LinearSolver::kAuto);
+  EXPECT_EQ(s.solver.tolerance, 1e-10);
+  EXPECT_TRUE(s.outputs.vtu);
+  EXPECT_FALSE(s.outputs.inp);
+  ASSERT_EQ(s.muscles.size(), 1u);
+  EXPECT_EQ(s.muscles[0].radius_mm, 10);
+  EXPECT_EQ(s.muscles[0].where.line, 5);
+  EXPECT_FALSE(s.muscles[0].insertion.resolved);
+  ASSERT_EQ(s.supports.size(), 3u);
+  EXPECT_EQ(s.supports[1].where.line, 9);
+  EXPECT_EQ(s.supports[0].at.name, "right_first_molar_bite_point");
+  EXPECT_EQ(s.supports[0].fixed, (std::array<bool, 3>{true, true, true}));
+
+  const Landmarks l = generator_landmarks();
+  resolve_points(s, l);
+  const Muscle& m = s.muscles[0];
+  EXPECT_EQ(*m.max_force_N, 190.4);
+  const Vec3 force = muscle_force(m);
+  EXPECT_NEAR(std::hypot(force[0], force[1], force[2]), 0.5 * 190.4, 1e-9);
+  EXPECT_EQ(s.supports[0].at.xyz, l.points.at("right_first_molar_bite_point"));
+  resolve_points(s, l);  // a second call changes nothing
+  EXPECT_EQ(s.supports[0].at.xyz, l.points.at("right_first_molar_bite_point"));
+}
+
+TEST(Scenario, EveryShippedScenarioLoadsAndResolves) {
+  const fs::path folder = fs::path(HEXBITE_SOURCE_DIR) / "scenarios";
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    ++count;
+    Scenario s = load_scenario(entry.path().string());
+    EXPECT_EQ(s.name, entry.path().stem().string());
+    resolve_points(s, generator_landmarks());
+    for (const Muscle& m : s.muscles) {
+      EXPECT_TRUE(m.insertion.resolved) << m.name;
+      EXPECT_TRUE(m.max_force_N.has_value()) << m.name;
+    }
+    for (const Support& support : s.supports) EXPECT_TRUE(support.at.resolved) << support.name;
+    for (const Probe& probe : s.probes) EXPECT_TRUE(probe.at.resolved) << probe.name;
+  }
+  EXPECT_GE(count, 3);
+}
+
+TEST(Scenario, LateralBiteHardNutIsThePapersSetUp) {
+  Scenario s = load_scenario(std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml");
+  EXPECT_EQ(s.geometry.source, GeometrySource::kMandible);
+  EXPECT_EQ(s.materials.default_material.E_MPa, 11000);
+  EXPECT_EQ(s.materials.default_material.poisson, 0.28);
+  ASSERT_EQ(s.muscles.size(), 18u);
+  auto activation = [&](const std::string& name) {
+    for (const Muscle& m : s.muscles)
+      if (m.name == name) return m.activation;
+    ADD_FAILURE() << "no muscle " << name;
+    return -1.0;
+  };
+  EXPECT_EQ(activation("right_superficial_masseter"), 0.56);
+  EXPECT_EQ(activation("left_superficial_masseter"), 0.20);
+  EXPECT_EQ(activation("right_anterior_temporalis"), 0.65);
+  EXPECT_EQ(activation("left_anterior_temporalis"), 0.51);
+  EXPECT_EQ(activation("right_medial_pterygoid"), 0.97);
+  EXPECT_EQ(activation("left_medial_pterygoid"), 0.47);
+  EXPECT_EQ(activation("right_inferior_lateral_pterygoid"), 0.50);
+  EXPECT_EQ(activation("left_inferior_lateral_pterygoid"), 0.36);
+  EXPECT_EQ(activation("left_anterior_digastric"), 0.0);
+  int bites = 0;
+  for (const Support& support : s.supports) {
+    if (!support.bite) continue;
+    ++bites;
+    EXPECT_EQ(support.at.name, "right_first_molar_bite_point");
+    EXPECT_EQ(support.fixed, (std::array<bool, 3>{true, true, true}));
+    EXPECT_FALSE(support.spring_N_per_mm3);
+  }
+  EXPECT_EQ(bites, 1);
+  std::vector<std::string> supported;
+  for (const Support& support : s.supports) supported.push_back(support.at.name);
+  EXPECT_NE(std::find(supported.begin(), supported.end(), "left_condyle_tmj_point"), supported.end());
+  EXPECT_NE(std::find(supported.begin(), supported.end(), "right_condyle_tmj_point"), supported.end());
+}
+
+TEST(Scenario, RealJawRightMolarResolvesAgainstItsLandmarkFile) {
+  const std::string jaw = test::shared_data("jaw/jaw_smooth.stl");
+  const std::string landmarks = test::shared_data("jaw/landmarks.yaml");
+  const std::string path = write_scenario(R"(name: real_jaw_right_molar
+geometry:
+  surface: {file: )" + jaw + R"(, units: mm}
+landmarks: {file: )" + landmarks + R"(}
+activation_pattern:
+  superficial_masseter: {right: 0.56, left: 0.20}
+  deep_masseter: {right: 0.56, left: 0.20}
+  anterior_temporalis: {right: 0.65, left: 0.51}
+  middle_temporalis: {right: 0.65, left: 0.51}
+  posterior_temporalis: {right: 0.65, left: 0.51}
+  medial_pterygoid: {right: 0.97, left: 0.47}
+  inferior_lateral_pterygoid: {right: 0.50, left: 0.36}
+  superior_lateral_pterygoid: {right: 0.50, left: 0.36}
+  anterior_digastric: 0
+supports:
+  - {name: bite, at: right_first_molar_bite_point, radius_mm: 4, bite: true}
+  - {name: right_tmj, at: right_condyle_tmj_point, radius_mm: 6}
+  - {name: left_tmj, at: left_condyle_tmj_point, radius_mm: 6}
+)",
+                                          "real_jaw_right_molar.yaml");
+  Scenario s = load_scenario(path);
+  EXPECT_EQ(s.geometry.source, GeometrySource::kSurface);
+  EXPECT_EQ(s.landmarks.file, fs::path(landmarks).lexically_normal().string());
+  resolve_points(s, read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm));
+  EXPECT_NEAR(s.supports[0].at.xyz[0], -24.80, 1e-9);
+  for (const Muscle& m : s.muscles) {
+    if (m.name == "right_medial_pterygoid") {
+      EXPECT_NEAR(*m.max_force_N, 174.8, 1e-9);
+    }
+  }
+}
+
+TEST(Scenario, RelativeFilesAreResolvedAgainstTheScenarioFolder) {
+  const std::string dir = test::temp_dir();
+  fs::create_directories(dir + "/data");
+  test::write_file(dir + "/data/jaw.stl", "solid x\nendsolid x\n");
+  test::write_file(dir + "/s.yaml", replace(kValid, "mandible: {variant: dentate}",
+                                            "surface: {file: data/jaw.stl, units: cm}"));
+  const Scenario s = load_scenario(dir + "/s.yaml");
+  EXPECT_EQ(s.geometry.file, (fs::path(dir) / "data/jaw.stl").string());
+  EXPECT_EQ(s.geometry.scale_to_mm, 10.0);
+  EXPECT_EQ(s.landmarks.scale_to_mm, 10.0);  // a landmark file shares the surface's unit by default
+
+  EXPECT_ERROR_AT(error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: missing.stl}")),
+                  3, "surface file 'missing.stl'");
+}
+
+TEST(Scenario, ActivationPatternExpandsToBothSides) {
+  Scenario s = load_scenario(
+      write_scenario(replace(kValid, "muscles:\n  - name: right_superficial_masseter\n    activation: 0.5\n",
+                             "activation_pattern:\n  deep_masseter: 0.3\n"
+                             "  medial_pterygoid: {right: 0.97}\n")));
+  ASSERT_EQ(s.muscles.size(), 3u);
+  EXPECT_EQ(s.muscles[0].name, "left_deep_masseter");
+  EXPECT_EQ(s.muscles[1].name, "right_deep_masseter");
+  EXPECT_EQ(s.muscles[1].activation, 0.3);
+  EXPECT_EQ(s.muscles[2].name, "right_medial_pterygoid");
+  EXPECT_EQ(s.muscles[2].where.line, 6);
+  resolve_points(s, generator_landmarks());
+  EXPECT_EQ(*s.muscles[2].max_force_N, 174.8);
+}
+
+TEST(Scenario, MaterialRegionsOverrideTheDefault) {
+  Scenario s = load_scenario(write_scenario(kValid + R"(materials:
+  default: {E_MPa: 12000}
+  regions:
+    - {name: implant, sphere: {center: incisal_point, radius_mm: 5}, E_MPa: 110000, poisson: 0.33}
+    - {name: block, box: {min: [-1, -1, -1], max: [1, 1, 1]}, poisson: 0.3}
+)"));
+  resolve_points(s, generator_landmarks());
+  EXPECT_EQ(material_at(s.materials, {0, -45, 46}).E_MPa, 110000);
+  EXPECT_EQ(material_at(s.materials, {0, 0, 0}).E_MPa, 12000);
+  EXPECT_EQ(material_at(s.materials, {0, 0, 0}).poisson, 0.3);
+  EXPECT_EQ(material_at(s.materials, {50, 50, 50}).poisson, 0.28);
+}
+
+// ----- one test per validation error -----
+
+TEST(ScenarioErrors, UnknownKeySuggestsTheClosest) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "    activation: 0.5", "    activaton: 0.5")), 6,
+                  "unknown key 'activaton' in muscles[0]; did you mean 'activation'?");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "supports:", "suports:")), 7, "did you mean 'supports'?");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "variant: dentate", "variant: dentat")), 3,
+                  "did you mean 'dentate'?");
+}
+
+TEST(ScenarioErrors, RepeatedKey) {
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    activation: 0.6")), 7,
+      "key 'activation' appears twice in muscles[0] (first on line 6)");
+}
+
+TEST(ScenarioErrors, MissingRequiredFields) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "name: t\n", "description: no name\n")), 1,
+                  "the scenario has no 'name', which is required");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "    activation: 0.5", "    radius_mm: 8")), 5,
+                  "muscles[0] has no 'activation', which is required");
+  EXPECT_ERROR_AT(error_of(replace(kValid, ", radius_mm: 6}\n  - {name: left", "}\n  - {name: left")), 9,
+                  "supports[1] has no 'radius_mm'");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "geometry:\n  mandible: {variant: dentate}\n", "")), 1,
+                  "has no 'geometry'");
+}
+
+TEST(ScenarioErrors, IllTypedFields) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: high")), 6,
+                  "muscles[0].activation must be a number, found 'high'");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: \"0.5\"")), 6,
+                  "must be a number, found the quoted text \"0.5\"");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 2.5}\n"), 11,
+                  "mesh.target_hexes must be a whole number");
+  EXPECT_ERROR_AT(error_of(kValid + "outputs: {vtu: maybe}\n"), 11, "outputs.vtu must be true or false");
+  EXPECT_ERROR_AT(error_of(kValid + "probes: {name: x}\n"), 11, "probes must be a list");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "at: right_condyle_tmj_point", "at: [1, 2]")), 9,
+                  "supports[1].at must be three numbers [x, y, z]");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "at: right_condyle_tmj_point", "at: 12")), 9,
+                  "supports[1].at must be a point");
+}
+
+TEST(ScenarioErrors, YoungsModulusMustBePositive) {
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 0}\n"), 12,
+                  "materials.default.E_MPa is 0 MPa but Young's modulus must be positive");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  regions:\n    - {name: r, sphere: {center: [0, 0, 0], "
+                                    "radius_mm: 2}, E_MPa: -5}\n"),
+                  13, "materials.regions[0].E_MPa is -5 MPa");
+}
+
+TEST(ScenarioErrors, PoissonOutsideItsRange) {
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: 0.5}\n"), 12,
+                  "Poisson's ratio must lie strictly between -1 and 0.5");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: -1}\n"), 12,
+                  "materials.default.poisson is -1");
+}
+
+TEST(ScenarioErrors, ActivationOutsideZeroOne) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: 1.5")), 6,
+                  "muscles[0].activation is 1.5 but an activation must lie in [0, 1]");
+  EXPECT_ERROR_AT(error_of(kValid + "activation_pattern:\n  deep_masseter: {left: -0.1}\n"), 12,
+                  "activation_pattern.deep_masseter.left is -0.1");
+}
+
+TEST(ScenarioErrors, NegativeRadiusOrForce) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    radius_mm: -3")),
+                  7, "muscles[0].radius_mm is -3 but must be positive (it is negative)");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    max_force_N: -10")), 7,
+      "muscles[0].max_force_N is -10 but must be positive");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "radius_mm: 4", "radius_mm: -4")), 8,
+                  "supports[0].radius_mm is -4");
+}
+
+TEST(ScenarioErrors, ZeroLineOfAction) {
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    direction: [0, 0, 0]")), 7,
+      "muscle 'right_superficial_masseter' has a zero line of action");
+  // Only known once the names are resolved: the origin is the insertion's own landmark.
+  EXPECT_ERROR_AT(error_of(replace(kValid, "    activation: 0.5",
+                                   "    activation: 0.5\n    origin: right_superficial_masseter.insertion"),
+                           true),
+                  7, "has a zero line of action: its origin equals its insertion");
+  EXPECT_ERROR_AT(
+      error_of(
+          replace(kValid, "    activation: 0.5",
+                  "    activation: 0.5\n    origin: right_deep_masseter.origin\n    direction: [0, 0, 1]")),
+      8, "has both 'origin' and 'direction'");
+}
+
+TEST(ScenarioErrors, NoSupportIsSingular) {
+  const std::string no_supports = kValid.substr(0, kValid.find("supports:"));
+  EXPECT_ERROR_AT(error_of(no_supports), 1, "no supports");
+  EXPECT_ERROR_AT(error_of(no_supports), 1, "singular");
+  EXPECT_ERROR_AT(error_of(no_supports + "supports: []\n"), 7, "the problem is singular");
+  EXPECT_ERROR_AT(
+      error_of(no_supports +
+               "supports:\n  - {name: a, at: incisal_point, radius_mm: 3, fixed: [z], bite: true}\n"),
+      7, "no support holds the mandible along x");
+}
+
+TEST(ScenarioErrors, NoBiteSupportWhenTheBiteForceIsReported) {
+  const std::string no_bite = replace(kValid, ", bite: true}", "}");
+  EXPECT_ERROR_AT(error_of(no_bite), 7, "no support is marked 'bite: true'");
+  EXPECT_NO_THROW(load_scenario(write_scenario(no_bite + "outputs: {bite_force: false}\n")));
+}
+
+TEST(ScenarioErrors, NoActiveMuscle) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: 0")), 4, "no muscle is active");
+}
+
+TEST(ScenarioErrors, DuplicateNames) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "{name: left_condyle", "{name: right_condyle")), 10,
+                  "support 'right_condyle' is defined twice (first on line 9)");
+  EXPECT_ERROR_AT(error_of(kValid + "activation_pattern:\n  superficial_masseter: 0.2\n"), 12,
+                  "muscle 'right_superficial_masseter' is defined twice (first on line 5)");
+  EXPECT_ERROR_AT(
+      error_of(kValid + "probes:\n  - {name: p, at: incisal_point}\n  - {name: p, at: [0, 0, 0]}\n"), 13,
+      "probe 'p' is defined twice");
+  EXPECT_ERROR_AT(error_of(kValid + "landmarks:\n  points:\n    incisal_point: [0, 0, 0]\n", true), 13,
+                  "extra point 'incisal_point' has the name of a landmark");
+}
+
+TEST(ScenarioErrors, FixedAndSpringTogether) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "radius_mm: 6}\n  - {name: left",
+                                   "radius_mm: 6, fixed: [x, y, z], spring_N_per_mm3: 50}\n  - {name: left")),
+                  9, "support 'right_condyle' has both 'fixed' and 'spring_N_per_mm3'");
+}
+
+TEST(ScenarioErrors, UnknownPointNameListsTheClosestNames) {
+  const std::string message =
+      error_of(replace(kValid, "at: right_first_molar_bite_point", "at: right_molar_bite"), true);
+  EXPECT_ERROR_AT(message, 8,
+                  "unknown point name 'right_molar_bite'; the closest known names are "
+                  "'right_first_molar_bite_point'");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "right_superficial_masseter", "right_superficial_maseter"), true),
+                  5,
+                  "muscle 'right_superficial_maseter' is not a muscle of the landmarks (closest: "
+                  "'right_superficial_masseter'");
+}
+
+TEST(ScenarioErrors, GeometryNeedsExactlyOneSource) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/jaw.stl", "solid x\nendsolid x\n");
+  test::write_file(dir + "/bad.yaml", replace(kValid, "mandible: {variant: dentate}",
+                                              "mandible: {}\n  surface: {file: jaw.stl}"));
+  try {
+    load_scenario(dir + "/bad.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_ERROR_AT(std::string(e.what()), 4, "geometry has both 'mandible' and 'surface'");
+  }
+}
+
+TEST(ScenarioErrors, YamlSyntaxAndEmptyFiles) {
+  EXPECT_ERROR_AT(error_of("name: t\ngeometry: {mandible: [1, 2\n"), 3, "YAML syntax error");
+  EXPECT_ERROR_AT(error_of(""), 1, "the scenario file is empty");
+  EXPECT_THROW(load_scenario("/nonexistent/scenario.yaml"), InputError);
+}
+
+// ----- patches -----
+
+QuadSurface unit_cube() {
+  QuadSurface cube;
+  cube.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  cube.quads = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  return cube;
+}
+
+TEST(Patches, SelectFacetsWhoseCentreIsWithinTheRadius) {
+  const QuadSurface cube = unit_cube();
+  EXPECT_EQ(select_patch_quads(cube, {0.5, 0.5, 1.1}, 0.2), (std::vector<int>{1}));
+  EXPECT_EQ(select_patch_quads(cube, {0.5, 0.5, 0.5}, 0.5), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_TRUE(select_patch_quads(cube, {0.5, 0.5, 0.5}, 0.4).empty());
+  EXPECT_TRUE(select_patch_quads(cube, {5, 5, 5}, 1).empty());
+}
+
+TEST(Patches, AnEmptyPatchIsReportedAtItsScenarioLine) {
+  Scenario s = load_scenario(write_scenario(kValid));
+  resolve_points(s, generator_landmarks());
+  const Support& nut = s.supports[0];
+  try {
+    require_patch_quads(unit_cube(), nut.at.xyz, nut.radius_mm, nut.where, "support '" + nut.name + "'");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_ERROR_AT(std::string(e.what()), 8, "support 'nut' selects no surface facets");
+    EXPECT_ERROR_AT(std::string(e.what()), 8, "increase radius_mm");
+  }
+  EXPECT_EQ(require_patch_quads(unit_cube(), {0.5, 0.5, 1}, 0.1, nut.where, "support"),
+            (std::vector<int>{1}));
+}
+
+}  // namespace
+}  // namespace hexbite
