@@ -1,4 +1,5 @@
-// hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--json] [--allow-invalid]
+// hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--json]
+// [--allow-invalid]
 //
 // Meshes a closed triangulated solid with hexahedra (overlay grid + pillow layer + optimization) and prints
 // the quality per phase (like the seed paper's Table 1), the timings and the geometric fidelity. A mesh
@@ -47,8 +48,9 @@ std::string fmt(const char* format, double v) {
 std::string phase_table(const OptimizeReport& r) {
   std::ostringstream out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-12s %8s %8s %8s   %8s %8s %8s   %8s %10s   %8s %8s\n", "phase", "SJ min",
-                "SJ mean", "SJ max", "k min", "k mean", "k max", "Oddy avg", "Oddy max", "inverted", "seconds");
+  std::snprintf(line, sizeof line, "%-12s %8s %8s %8s   %8s %8s %8s   %8s %10s   %8s %8s\n", "phase",
+                "SJ min", "SJ mean", "SJ max", "k min", "k mean", "k max", "Oddy avg", "Oddy max", "inverted",
+                "seconds");
   out << line;
   for (const PhaseQuality& p : r.phases) {
     const QualitySummary& q = p.quality;
@@ -67,8 +69,8 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
   out << "Meshed " << o.surface << " (grid + pillow): " << mesh.hexes.size() << " hexes (" << r.core_hexes
-      << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target "
-      << o.target << "\n";
+      << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
+      << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core\n\n";
   out << phase_table(r.optimize) << '\n';
@@ -79,15 +81,17 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << " s, optimization " << fmt("%.2f", r.seconds_optimize) << " s, fidelity "
       << fmt("%.2f", r.seconds_fidelity) << " s, total " << fmt("%.2f", r.seconds_total) << " s\n";
   out << "fidelity: Hausdorff distance " << fmt("%.3f", f.hausdorff) << " mm (mesh -> surface "
-      << fmt("%.3f", f.hausdorff_mesh_to_surface) << ", surface -> mesh " << fmt("%.3f", f.hausdorff_surface_to_mesh)
-      << "), mean edge length " << fmt("%.3f", f.mean_edge_length) << " mm\n";
+      << fmt("%.3f", f.hausdorff_mesh_to_surface) << ", surface -> mesh "
+      << fmt("%.3f", f.hausdorff_surface_to_mesh) << "), mean edge length " << fmt("%.3f", f.mean_edge_length)
+      << " mm\n";
   out << "volume: mesh " << fmt("%.1f", f.mesh_volume) << " mm^3, surface " << fmt("%.1f", f.surface_volume)
       << " mm^3, difference " << fmt("%+.2f", 100.0 * f.volume_difference) << " %\n";
   if (!f.unresolved.empty()) {
     out << "not resolved at this size (" << f.unresolved.size() << " regions):\n";
     const std::size_t shown = std::min<std::size_t>(f.unresolved.size(), 10);
     for (std::size_t i = 0; i < shown; ++i) out << "  " << f.unresolved[i].what << '\n';
-    if (shown < f.unresolved.size()) out << "  ... and " << f.unresolved.size() - shown << " smaller regions\n";
+    if (shown < f.unresolved.size())
+      out << "  ... and " << f.unresolved.size() - shown << " smaller regions\n";
   }
   return out.str();
 }
@@ -122,7 +126,8 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   const MeshFidelity& f = r.fidelity;
   nlohmann::json unresolved = nlohmann::json::array();
   for (const UnresolvedPart& u : f.unresolved)
-    unresolved.push_back({{"location", u.location}, {"extent_mm", u.extent}, {"samples", u.samples}, {"what", u.what}});
+    unresolved.push_back(
+        {{"location", u.location}, {"extent_mm", u.extent}, {"samples", u.samples}, {"what", u.what}});
   j["fidelity"] = {{"hausdorff_mm", f.hausdorff},
                    {"hausdorff_mesh_to_surface_mm", f.hausdorff_mesh_to_surface},
                    {"hausdorff_surface_to_mesh_mm", f.hausdorff_surface_to_mesh},
@@ -145,7 +150,8 @@ std::string inverted_list(const HexMesh& mesh, const std::vector<int>& inverted)
     for (int v : mesh.hexes[inverted[i]])
       for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
     char buf[128];
-    std::snprintf(buf, sizeof buf, "%shex %d at (%.2f, %.2f, %.2f) mm", i ? ", " : "", inverted[i], c[0], c[1], c[2]);
+    std::snprintf(buf, sizeof buf, "%shex %d at (%.2f, %.2f, %.2f) mm", i ? ", " : "", inverted[i], c[0],
+                  c[1], c[2]);
     out << buf;
   }
   if (shown < inverted.size()) out << " and " << inverted.size() - shown << " more";
@@ -182,8 +188,8 @@ void run_mesh(const MeshOptions& o) {
                 << " inverted hexes on purpose (--allow-invalid): " << list << '\n';
       return;
     }
-    throw RunError(std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " + list +
-                   "; no mesh written (--allow-invalid writes it anyway)");
+    throw RunError(std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " +
+                   list + "; no mesh written (--allow-invalid writes it anyway)");
   }
   if (!o.json) info("wrote " + o.output);
 }
@@ -194,7 +200,8 @@ void add_mesh_command(CLI::App& app) {
   auto o = std::make_shared<MeshOptions>();
   CLI::App* cmd = app.add_subcommand("mesh", "Mesh a closed triangulated solid with hexahedra");
   cmd->add_option("surface", o->surface, "Closed surface (.stl .obj .ply .off .vtp)")->required();
-  cmd->add_option("--method", o->method, "Meshing method: grid (overlay grid + pillow layer); sheets is not available yet")
+  cmd->add_option("--method", o->method,
+                  "Meshing method: grid (overlay grid + pillow layer); sheets is not available yet")
       ->check(CLI::IsMember({"grid", "sheets"}));
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")->default_val(2500);
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required();

@@ -73,8 +73,7 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
     out << quality_row(level + " split", l.parametric, l.seconds_split);
     if (o.surface.empty()) continue;
     out << quality_row(level + " projected", l.projected, l.seconds_project);
-    if (l.optimized)
-      out << quality_row(level + " optimized", l.optimize.phases.back().quality, l.seconds_optimize);
+    if (l.optimized) out << quality_row(level + " optimized", l.final_quality, l.seconds_optimize);
   }
   out << "(element scaled Jacobian SJ = minimum over the corners; condition number k = |A|_F |A^-1|_F, cube "
          "= 3, "
@@ -83,11 +82,17 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
     const RefineLevelReport& l = r.levels[i];
     out << "level " << i + 1 << ": " << l.projected_nodes << " boundary nodes projected (largest move "
         << fmt("%.4f", l.max_projection) << " mm), " << l.backed_off_nodes
-        << " backed off to avoid inverting a hex; "
-        << (l.optimized ? "re-optimized (" + std::to_string(l.optimize.iterations) + " L-BFGS iterations)"
-                        : std::string("not re-optimized (projection made nothing worse)"))
-        << "; largest distance of a new boundary node from the surface "
-        << fmt("%.2e", l.max_surface_distance) << " mm\n";
+        << " backed off to avoid inverting a hex, " << l.damaged_hexes << " hexes damaged; "
+        << (l.optimized ? "re-optimized " + std::to_string(l.optimized_hexes) + " hexes around them (" +
+                              std::to_string(l.optimize.iterations) + " L-BFGS iterations)"
+                        : std::string("not re-optimized (projection damaged nothing)"))
+        << '\n';
+    if (l.off_surface_nodes > 0)
+      out << "  warning: " << l.off_surface_nodes << " new boundary nodes stay off the surface (up to "
+          << fmt("%.3f", l.max_surface_distance)
+          << " mm) because moving them onto it would invert a hex; the coarse boundary is far from the "
+             "surface "
+             "there\n";
   }
   double split = 0, project = 0, optimize = 0;
   for (const RefineLevelReport& l : r.levels) {
@@ -119,7 +124,11 @@ nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, boo
         {"max_surface_distance_mm", l.max_surface_distance},
         {"split", quality_to_json(l.parametric)},
         {"projected", quality_to_json(l.projected)},
+        {"damaged_hexes", l.damaged_hexes},
+        {"off_surface_nodes", l.off_surface_nodes},
         {"optimized", l.optimized},
+        {"optimized_hexes", l.optimized_hexes},
+        {"final", quality_to_json(l.final_quality)},
         {"seconds",
          {{"split", l.seconds_split}, {"project", l.seconds_project}, {"optimize", l.seconds_optimize}}}};
     if (l.optimized)

@@ -376,7 +376,8 @@ int add_pillow_layer(HexMesh& mesh, const SurfaceProjector& surface, double h) {
       SurfacePoint opposite;
       const Vec3 inward = scale(near.normal, -1.0);
       const Vec3 start = add(near.point, scale(inward, 1e-6 * h));
-      if (surface.first_hit(start, inward, 3.0 * h, &opposite)) depth = std::min(depth, opposite.distance / 3.0);
+      if (surface.first_hit(start, inward, 3.0 * h, &opposite))
+        depth = std::min(depth, opposite.distance / 3.0);
       p = add(near.point, scale(inward, depth));
       mesh.vertices[boundary.boundary_vertices[i]] = p;
     }

@@ -32,33 +32,33 @@ class SurfaceProjector;
 
 struct GridMeshOptions {
   long target_hexes = 2500;
-  double margin = 0.75;  // cell centres at least margin * h inside the surface form the core
+  double margin = 0.25;  // cell centres at least margin * h inside the surface form the core
   OptimizeOptions optimize;
 };
 
 // A region of the surface that the mesh does not reach (a part too thin for the cell size, or a core
 // component that was dropped because it is not face-connected to the largest one).
 struct UnresolvedPart {
-  Vec3 location{};     // centroid of the region, mm
-  double extent = 0;   // largest distance of the region's surface from the mesh boundary, mm
-  int samples = 0;     // surface samples (vertices and triangle centroids) in the region
-  std::string what;    // one sentence
+  Vec3 location{};    // centroid of the region, mm
+  double extent = 0;  // largest distance of the region's surface from the mesh boundary, mm
+  int samples = 0;    // surface samples (vertices and triangle centroids) in the region
+  std::string what;   // one sentence
 };
 
 struct MeshFidelity {
-  double hausdorff_mesh_to_surface = 0;  // max over boundary samples of the distance to the surface, mm
-  double hausdorff_surface_to_mesh = 0;  // max over surface samples of the distance to the mesh boundary
-  double hausdorff = 0;                  // the larger of the two
-  double mean_edge_length = 0;           // over all hex edges, mm
-  double mesh_volume = 0;                // mm^3 (exact for trilinear hexes)
-  double surface_volume = 0;             // mm^3
-  double volume_difference = 0;          // (mesh - surface) / surface
+  double hausdorff_mesh_to_surface = 0;    // max over boundary samples of the distance to the surface, mm
+  double hausdorff_surface_to_mesh = 0;    // max over surface samples of the distance to the mesh boundary
+  double hausdorff = 0;                    // the larger of the two
+  double mean_edge_length = 0;             // over all hex edges, mm
+  double mesh_volume = 0;                  // mm^3 (exact for trilinear hexes)
+  double surface_volume = 0;               // mm^3
+  double volume_difference = 0;            // (mesh - surface) / surface
   std::vector<UnresolvedPart> unresolved;  // surface regions farther than half the mean edge length
 };
 
 struct GridMeshReport {
-  double cell_size = 0;          // h, mm
-  std::array<int, 3> grid{};     // grid cells per axis
+  double cell_size = 0;       // h, mm
+  std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;
   int pillow_hexes = 0;
   int cells_added_for_manifold = 0;
@@ -70,7 +70,8 @@ struct GridMeshReport {
 
 // Meshes the solid. Throws InputError when the target is not positive or when the surface encloses no
 // cell at any size; the returned mesh may contain inverted hexes (report.optimize.inverted says how many).
-HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report = nullptr);
+HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options,
+                  GridMeshReport* report = nullptr);
 
 // Volume of a hex mesh with trilinear hexes (2 x 2 x 2 Gauss points, exact for trilinear maps).
 double hex_mesh_volume(const HexMesh& mesh);

@@ -33,14 +33,14 @@ namespace hexbite {
 class SurfaceProjector;
 
 struct OptimizeOptions {
-  int barycentric_iterations = 10;    // Jacobi sweeps of Laplacian smoothing (0 skips the phase)
-  int max_untangle_sweeps = 60;       // sweeps over the nodes of inverted hexes, per untangling phase
-  int max_iterations = 1500;          // L-BFGS iterations over all rounds and repeats
-  int iterations_per_round = 40;      // iterations between two projections of the sliding boundary nodes
-  int lbfgs_memory = 8;               // correction pairs kept by L-BFGS
-  double tolerance = 1e-3;            // stop when max |node move| / local edge length < tolerance
-  bool slide_boundary = true;         // boundary nodes slide on the surface (needs a projector)
-  int max_repeats = 5;                // untangle + optimize cycles while hexes stay inverted
+  int barycentric_iterations = 10;  // Jacobi sweeps of Laplacian smoothing (0 skips the phase)
+  int max_untangle_sweeps = 60;     // sweeps over the nodes of inverted hexes, per untangling phase
+  int max_iterations = 1500;        // L-BFGS iterations over all rounds and repeats
+  int iterations_per_round = 40;    // iterations between two projections of the sliding boundary nodes
+  int lbfgs_memory = 8;             // correction pairs kept by L-BFGS
+  double tolerance = 1e-3;          // stop when max |node move| / local edge length < tolerance
+  bool slide_boundary = true;       // boundary nodes slide on the surface (needs a projector)
+  int max_repeats = 5;              // untangle + optimize cycles while hexes stay inverted
 };
 
 // One row of the per-phase table.
@@ -57,7 +57,7 @@ struct OptimizeReport {
   int rounds = 0;                    // boundary projection rounds
   double energy_before = 0.0;        // sum of squared corner condition numbers, valid hexes only
   double energy_after = 0.0;
-  int inverted = 0;                  // inverted hexes at the end
+  int inverted = 0;  // inverted hexes at the end
 };
 
 // Sum over every corner of every hex of kappa(A)^2, and its gradient with respect to the vertex positions
@@ -67,8 +67,8 @@ double condition_energy(const HexMesh& mesh, std::vector<Vec3>* gradient);
 
 // The whole embedding pipeline. `fixed` may be empty (nothing fixed) or hold one flag per vertex.
 // `surface` may be null: then boundary nodes stay where they are and outside nodes are not detected.
-OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface, const std::vector<char>& fixed,
-                                 const OptimizeOptions& options = {});
+OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface,
+                                 const std::vector<char>& fixed, const OptimizeOptions& options = {});
 
 // The individual phases, for callers that compose them differently. `movable[v]` != 0 for nodes that may
 // move; `sliding[v]` != 0 for movable nodes that must stay on the surface (needs `surface`).
@@ -80,6 +80,7 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
 // Returns the number of L-BFGS iterations. Hexes that are inverted on entry are left out of the objective,
 // and their nodes do not move.
 int optimize_condition(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
-                       const SurfaceProjector* surface, const OptimizeOptions& options, int* rounds = nullptr);
+                       const SurfaceProjector* surface, const OptimizeOptions& options,
+                       int* rounds = nullptr);
 
 }  // namespace hexbite

@@ -142,6 +142,63 @@ void project_new_boundary(HexMesh& mesh, int first_new, const SurfaceProjector& 
     if (projected[v] && halvings[v] > 0) ++report.backed_off_nodes;
 }
 
+// Hexes that the projection inverted or whose scaled Jacobian fell by more than the fraction `damage` of its
+// value after the split, and hexes holding a node that had to back off.
+std::vector<char> damaged_hexes(const HexMesh& mesh, const HexQualityField& split, double damage,
+                                int* count) {
+  const HexQualityField now = compute_hex_quality(mesh);
+  std::vector<char> damaged(mesh.hexes.size(), 0);
+  *count = 0;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    const double before = split.scaled_jacobian[h], after = now.scaled_jacobian[h];
+    if (!(now.jacobian[h] > 0.0) || after < before - damage * std::fabs(before)) {
+      damaged[h] = 1;
+      ++*count;
+    }
+  }
+  return damaged;
+}
+
+// Runs the optimizer on the damaged hexes grown by `rings` layers of hexes (sharing a node), as a submesh of
+// its own: nodes that the region shares with the hexes outside it stay fixed, so the rest of the mesh is
+// untouched and each objective evaluation costs the region's size, not the mesh's. Returns the region size.
+int optimize_region(HexMesh& mesh, std::vector<char> region, int rings, const std::vector<char>& fixed,
+                    const SurfaceProjector& surface, const OptimizeOptions& options, OptimizeReport* report) {
+  const std::size_t nv = mesh.vertices.size(), nh = mesh.hexes.size();
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<char> touched(nv, 0);
+    for (std::size_t h = 0; h < nh; ++h)
+      if (region[h])
+        for (int v : mesh.hexes[h]) touched[v] = 1;
+    for (std::size_t h = 0; h < nh; ++h)
+      for (int v : mesh.hexes[h])
+        if (touched[v]) region[h] = 1;
+  }
+  std::vector<char> inside(nv, 0), outside(nv, 0);
+  for (std::size_t h = 0; h < nh; ++h)
+    for (int v : mesh.hexes[h]) (region[h] ? inside : outside)[v] = 1;
+
+  HexMesh sub;
+  std::vector<int> local(nv, -1), global;
+  std::vector<char> sub_fixed;
+  for (std::size_t v = 0; v < nv; ++v)
+    if (inside[v]) {
+      local[v] = static_cast<int>(global.size());
+      global.push_back(static_cast<int>(v));
+      sub.vertices.push_back(mesh.vertices[v]);
+      sub_fixed.push_back(fixed[v] || outside[v]);
+    }
+  for (std::size_t h = 0; h < nh; ++h)
+    if (region[h]) {
+      std::array<int, 8> hex;
+      for (int k = 0; k < 8; ++k) hex[k] = local[mesh.hexes[h][k]];
+      sub.hexes.push_back(hex);
+    }
+  *report = optimize_hex_mesh(sub, &surface, sub_fixed, options);
+  for (std::size_t i = 0; i < global.size(); ++i) mesh.vertices[global[i]] = sub.vertices[i];
+  return static_cast<int>(sub.hexes.size());
+}
+
 }  // namespace
 
 HexMesh refine_uniform(const HexMesh& coarse, RefinementMap* map_out) {
@@ -237,27 +294,24 @@ HexMesh refine_to_surface(const HexMesh& coarse, const SurfaceProjector* surface
     lr.parametric = summarize_quality(mesh);
     if (surface == nullptr) {
       lr.projected = lr.parametric;
+      lr.final_quality = lr.parametric;
       report.levels.push_back(std::move(lr));
       continue;
     }
 
     t0 = std::chrono::steady_clock::now();
+    const HexQualityField split_quality = compute_hex_quality(mesh);
     project_new_boundary(mesh, map.coarse_vertices, *surface, lr);
     lr.projected = summarize_quality(mesh);
     lr.seconds_project = seconds_since(t0);
 
-    const QualitySummary& p = lr.parametric;
-    const QualitySummary& q = lr.projected;
-    const bool worse = q.inverted > 0 || lr.backed_off_nodes > 0 ||
-                       q.scaled_jacobian.min < p.scaled_jacobian.min || q.condition.max > p.condition.max;
-    if (options.optimize && worse) {
+    const std::vector<char> damaged = damaged_hexes(mesh, split_quality, options.damage, &lr.damaged_hexes);
+    if (options.optimize && (lr.damaged_hexes > 0 || lr.backed_off_nodes > 0)) {
       t0 = std::chrono::steady_clock::now();
-      std::vector<char> fixed;
-      if (options.keep_coarse_vertices) {
-        fixed.assign(mesh.vertices.size(), 0);
-        std::fill(fixed.begin(), fixed.begin() + original_vertices, 1);
-      }
-      lr.optimize = optimize_hex_mesh(mesh, surface, fixed, options.optimizer);
+      std::vector<char> fixed(mesh.vertices.size(), 0);
+      if (options.keep_coarse_vertices) std::fill(fixed.begin(), fixed.begin() + original_vertices, 1);
+      lr.optimized_hexes = optimize_region(mesh, damaged, options.optimize_rings, fixed, *surface,
+                                           options.optimizer, &lr.optimize);
       lr.optimized = true;
       lr.seconds_optimize = seconds_since(t0);
     }
@@ -265,11 +319,15 @@ HexMesh refine_to_surface(const HexMesh& coarse, const SurfaceProjector* surface
     // Refinement-created boundary nodes of every level so far: all of them should be on the surface.
     const std::vector<char> boundary = boundary_vertex_mask(mesh);
     for (int v = original_vertices; v < static_cast<int>(mesh.vertices.size()); ++v)
-      if (boundary[v])
-        lr.max_surface_distance = std::max(lr.max_surface_distance, surface->distance(mesh.vertices[v]));
+      if (boundary[v]) {
+        const double d = surface->distance(mesh.vertices[v]);
+        lr.max_surface_distance = std::max(lr.max_surface_distance, d);
+        if (d > 1e-6) ++lr.off_surface_nodes;
+      }
+    lr.final_quality = summarize_quality(mesh);
     report.levels.push_back(std::move(lr));
   }
-  report.after = report.levels.empty() ? report.before : summarize_quality(mesh);
+  report.after = report.levels.empty() ? report.before : report.levels.back().final_quality;
   report.seconds_total = seconds_since(t_start);
   if (report_out) *report_out = std::move(report);
   return mesh;

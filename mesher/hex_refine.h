@@ -12,7 +12,8 @@
 // centres and the hex centres, each in the order of RefinementMap below. Fine hex 8 h + c is the child of
 // coarse hex h that holds its corner c, so fine hex f lies in coarse hex f / 8 (f / 8^L after L levels).
 // Cost: sorts the 12 m edges and 6 m faces, O(m log m) for m hexes; refine_to_surface adds one closest-point
-// query per new boundary node and, when the projection made the quality worse, one optimizer run.
+// query per new boundary node and, when the projection damaged hexes, one optimizer run on the region
+// around them (its cost grows with the region, not with the whole mesh).
 // Deterministic: sorted keys, no hashing, single-threaded.
 #pragma once
 
@@ -47,9 +48,12 @@ struct RefineOptions {
   // Coarse vertices keep their positions (the optimizer may not move them), so that the fine mesh contains
   // every coarse node where the coarse solution was computed.
   bool keep_coarse_vertices = true;
-  // Re-optimize a level when projecting its new boundary nodes lowered the minimum scaled Jacobian, raised
-  // the maximum condition number or had to be backed off to avoid inverting a hex.
+  // Re-optimize a level when projecting its new boundary nodes damaged a hex: inverted it, lowered its scaled
+  // Jacobian by more than `damage` (relative to the split hex), or had to back a node off. Only the damaged
+  // hexes and `optimize_rings` layers of hexes around them move; the rest keeps the exact split positions.
   bool optimize = true;
+  double damage = 0.1;
+  int optimize_rings = 2;
   // Barycentric smoothing is off: the refined mesh is already smooth, and Laplacian smoothing would pull
   // the fine mesh away from the coarse one that it is meant to validate.
   OptimizeOptions optimizer = [] {
@@ -69,8 +73,12 @@ struct RefineLevelReport {
   double max_surface_distance = 0.0;  // largest distance of a new boundary node from the surface at the end
   QualitySummary parametric;          // after splitting, before projection
   QualitySummary projected;           // after projection and back-off
+  int damaged_hexes = 0;              // hexes the projection damaged (see RefineOptions::damage)
+  int optimized_hexes = 0;            // hexes in the re-optimized region, 0 when the optimizer did not run
+  int off_surface_nodes = 0;          // new boundary nodes farther than 1e-6 mm from the surface at the end
   bool optimized = false;             // whether the optimizer ran on this level
-  OptimizeReport optimize;            // its report, when it ran
+  OptimizeReport optimize;            // its report (qualities over the region only), when it ran
+  QualitySummary final_quality;       // the whole mesh at the end of the level
   double seconds_split = 0.0, seconds_project = 0.0, seconds_optimize = 0.0;
 };
 
@@ -83,8 +91,9 @@ struct RefineReport {
 
 // `levels` rounds of refine_uniform; with a surface, after each round the new boundary nodes are projected
 // onto it (closest point). Where a projection would invert a hex, the node backs off toward its parametric
-// position (halving the step, down to the parametric position itself). When that made the quality worse, the
-// optimizer runs with the new boundary nodes sliding on the surface. `surface` may be null: then this is
+// position (halving the step, down to the parametric position itself). Where that damaged hexes, the
+// optimizer runs on the region around them (a submesh whose cut nodes are fixed) with the new boundary
+// nodes sliding on the surface. `surface` may be null: then this is
 // plain parametric refinement with a report. The result may still hold inverted hexes (report.after says
 // which): callers decide whether that is an error.
 HexMesh refine_to_surface(const HexMesh& coarse, const SurfaceProjector* surface,

@@ -3,6 +3,11 @@
 #include "solver/mpi_session.h"
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/lac/la_parallel_block_vector.h>
+#include <deal.II/lac/la_parallel_vector.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/lac/vector_memory.h>
 
 namespace hexbite {
 namespace {
@@ -22,7 +27,19 @@ char** fallback_argv = fallback_argv_storage;
 void start(int& argc, char**& argv) {
   // One thread per rank: the solver's assembly is sequential per rank and the machine's cores are
   // better used by MPI ranks than by threads competing with them.
-  if (session_count++ == 0) mpi_init = new dealii::Utilities::MPI::MPI_InitFinalize(argc, argv, 1);
+  if (session_count++ > 0) return;
+  mpi_init = new dealii::Utilities::MPI::MPI_InitFinalize(argc, argv, 1);
+  // MPI_InitFinalize's destructor empties deal.II's pools of MPI vectors (function-local statics, created on
+  // first use, e.g. by CG). A pool first used after a global MpiSession was built would be destroyed before
+  // it at exit, and the session's destructor would then touch a dead pool. Creating the pools now, inside
+  // this constructor, makes them outlive every session, global or local.
+  using namespace dealii;
+  GrowingVectorMemory<LinearAlgebra::distributed::Vector<double>>::release_unused_memory();
+  GrowingVectorMemory<LinearAlgebra::distributed::BlockVector<double>>::release_unused_memory();
+  GrowingVectorMemory<LinearAlgebra::distributed::Vector<float>>::release_unused_memory();
+  GrowingVectorMemory<LinearAlgebra::distributed::BlockVector<float>>::release_unused_memory();
+  GrowingVectorMemory<TrilinosWrappers::MPI::Vector>::release_unused_memory();
+  GrowingVectorMemory<TrilinosWrappers::MPI::BlockVector>::release_unused_memory();
 }
 
 }  // namespace

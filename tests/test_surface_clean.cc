@@ -252,12 +252,14 @@ TEST(SurfaceClean, GeneratedMandible) {
 }
 
 TEST(SurfaceClean, Deterministic) {
-  const TriSurface& jaw = real_jaw();
+  // Angle cleanup, size reduction and flips all run; the real jaw at the defaults is compared byte
+  // for byte through the command line below.
+  const TriSurface sphere = uv_sphere(20.0, 40, 90);
   CleanOptions options;
-  options.target_triangles = 30000;
+  options.target_triangles = 2000;
   const std::string dir = temp_dir();
-  write_surface(dir + "/a.stl", clean_surface(jaw, options, nullptr));
-  write_surface(dir + "/b.stl", clean_surface(jaw, options, nullptr));
+  write_surface(dir + "/a.stl", clean_surface(sphere, options, nullptr));
+  write_surface(dir + "/b.stl", clean_surface(sphere, options, nullptr));
   EXPECT_EQ(test::read_file(dir + "/a.stl"), test::read_file(dir + "/b.stl"));
 }
 
