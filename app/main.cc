@@ -1,17 +1,25 @@
 // The hexbite command line: parses options with CLI11 and maps errors to exit codes
-// (0 ok, 1 failed run, 2 bad input or usage).
+// (0 ok, 1 failed run, 2 bad input or usage). MPI is initialized once here for every command, so that
+// `mpirun -np N hexbite run ...` works; without mpirun the program is a single rank.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <string>
 
 #include "app/commands.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "solver/mpi_session.h"
 
 #ifndef HEXBITE_VERSION
 #define HEXBITE_VERSION "unknown"
 #endif
 
 int main(int argc, char** argv) {
+  const hexbite::MpiSession mpi(argc, argv);
+  // Only rank 0 reports progress and results; errors are reported by every rank that meets them.
+  const bool root = hexbite::MpiSession::rank() == 0;
+  const std::string rank_prefix =
+      hexbite::MpiSession::size() > 1 ? "[rank " + std::to_string(hexbite::MpiSession::rank()) + "] " : "";
   CLI::App app{"hexbite: hexahedral meshing and bite simulation of the human mandible"};
   app.set_version_flag("--version", std::string("hexbite ") + HEXBITE_VERSION);
   bool quiet = false;
@@ -19,7 +27,7 @@ int main(int argc, char** argv) {
       ->configurable(false);
   app.require_subcommand(1);
   app.fallthrough();  // --quiet may follow the subcommand
-  app.parse_complete_callback([&] { hexbite::set_quiet(quiet); });
+  app.parse_complete_callback([&] { hexbite::set_quiet(quiet || !root); });
 
   hexbite::add_surface_commands(app);
   hexbite::add_generate_commands(app);
@@ -28,6 +36,7 @@ int main(int argc, char** argv) {
   hexbite::add_mesh_command(app);
   hexbite::add_refine_command(app);
   hexbite::add_reorder_command(app);
+  hexbite::add_run_command(app);
 
   try {
     app.parse(argc, argv);
@@ -41,13 +50,13 @@ int main(int argc, char** argv) {
     app.exit(e);  // prints the message and a hint to --help
     return hexbite::kExitBadInput;
   } catch (const hexbite::InputError& e) {
-    std::cerr << "hexbite: error: " << e.what() << '\n';
+    std::cerr << rank_prefix << "hexbite: error: " << e.what() << '\n';
     return hexbite::kExitBadInput;
   } catch (const hexbite::RunError& e) {
-    std::cerr << "hexbite: failed: " << e.what() << '\n';
+    std::cerr << rank_prefix << "hexbite: failed: " << e.what() << '\n';
     return hexbite::kExitRunFailed;
   } catch (const std::exception& e) {
-    std::cerr << "hexbite: failed: " << e.what() << '\n';
+    std::cerr << rank_prefix << "hexbite: failed: " << e.what() << '\n';
     return hexbite::kExitRunFailed;
   }
   return hexbite::kExitOk;

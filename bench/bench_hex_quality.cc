@@ -4,6 +4,7 @@
 #include <random>
 #include <vector>
 
+#include "mesher/hex_block.h"
 #include "mesher/hex_quality.h"
 
 namespace {
@@ -14,19 +15,11 @@ using hexbite::Vec3;
 // An nx x ny x nz grid of unit cubes whose vertices are moved randomly by up to 0.2, so that the kernels see
 // general (valid) hexes rather than the special case of a cube.
 HexMesh perturbed_grid(int nx, int ny, int nz) {
-  HexMesh mesh;
+  HexMesh mesh = hexbite::make_block_mesh(nx, ny, nz);
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({i + u(rng), j + u(rng), k + u(rng)});
-  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
+  for (Vec3& v : mesh.vertices)
+    for (double& c : v) c += u(rng);
   return mesh;
 }
 

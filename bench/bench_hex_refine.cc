@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "mesher/hex_block.h"
 #include "mesher/hex_refine.h"
 #include "mesher/hex_reorder.h"
 
@@ -15,17 +16,7 @@ using hexbite::HexMesh;
 
 // An n x n x n block of unit cubes with randomly numbered nodes, so that reordering has work to do.
 HexMesh shuffled_block(int n) {
-  HexMesh mesh;
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) mesh.vertices.push_back({double(i), double(j), double(k)});
-  const auto id = [&](int i, int j, int k) { return i + (n + 1) * (j + (n + 1) * k); };
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
+  HexMesh mesh = hexbite::make_block_mesh(n, n, n);
   std::vector<int> perm(mesh.vertices.size());
   for (std::size_t i = 0; i < perm.size(); ++i) perm[i] = static_cast<int>(i);
   std::shuffle(perm.begin(), perm.end(), std::mt19937(42));

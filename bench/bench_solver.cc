@@ -3,6 +3,7 @@
 //   build/bench/bench_solver --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
+#include "mesher/hex_block.h"
 #include "mesher/hex_mesh.h"
 #include "solver/elasticity.h"
 #include "solver/mpi_session.h"
@@ -12,24 +13,10 @@ namespace {
 const hexbite::MpiSession mpi_session;
 
 // An nx x ny x nz block of hexes on [0, 100] x [0, 25] x [0, 25] mm, in VTK node order.
-hexbite::HexMesh block(int nx, int ny, int nz) {
-  hexbite::HexMesh mesh;
-  auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({100.0 * i / nx, 25.0 * j / ny, 25.0 * k / nz});
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
-  return mesh;
-}
 
 void BM_SolveQ1Cantilever(benchmark::State& state) {
   const int nx = 100, ny = 25, nz = 25;
-  const hexbite::HexMesh mesh = block(nx, ny, nz);
+  const hexbite::HexMesh mesh = hexbite::make_block_mesh(nx, ny, nz, {0.0, 0.0, 0.0}, {100.0, 25.0, 25.0});
   auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
   hexbite::ElasticityProblem problem;
   problem.mesh = &mesh;

@@ -36,7 +36,12 @@ using VI = Mesh::Vertex_index;
 using HI = Mesh::Halfedge_index;
 using EI = Mesh::Edge_index;
 using FI = Mesh::Face_index;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, CGAL::AABB_face_graph_triangle_primitive<Mesh>>>;
+// Distance queries against the input run on a plain double kernel: they compare distances with a
+// bound, where the filtered kernel's exact fallback (frequent, as many query points lie exactly on
+// the input) costs time and buys nothing. The same holds for the final Hausdorff measurement.
+using Plain = CGAL::Simple_cartesian<double>;
+using PlainMesh = CGAL::Surface_mesh<Plain::Point_3>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Plain, CGAL::AABB_face_graph_triangle_primitive<PlainMesh>>>;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
@@ -93,6 +98,15 @@ Mesh to_mesh(const TriSurface& surface) {
   return mesh;
 }
 
+PlainMesh to_plain_mesh(const TriSurface& surface) {
+  PlainMesh mesh;
+  for (const Vec3& v : surface.vertices) mesh.add_vertex(Plain::Point_3(v[0], v[1], v[2]));
+  for (const auto& t : surface.triangles)
+    mesh.add_face(PlainMesh::Vertex_index(t[0]), PlainMesh::Vertex_index(t[1]),
+                  PlainMesh::Vertex_index(t[2]));
+  return mesh;
+}
+
 std::array<VI, 3> face_vertices(const Mesh& mesh, FI f) {
   const HI h = mesh.halfedge(f);
   return {mesh.source(h), mesh.target(h), mesh.target(mesh.next(h))};
@@ -126,8 +140,8 @@ struct Plan {
 class Cleaner {
  public:
   Cleaner(const TriSurface& surface, const CleanOptions& options, double margin)
-      : input_(to_mesh(surface)),
-        mesh_(input_),
+      : input_(to_plain_mesh(surface)),
+        mesh_(to_mesh(surface)),
         tree_(faces(input_).first, faces(input_).second, input_),
         threshold_(options.min_angle_deg * kDeg),
         bound2_(std::pow(margin * options.max_deviation_mm, 2)),
@@ -156,7 +170,6 @@ class Cleaner {
     }
   }
 
-  const Mesh& input() const { return input_; }
   const Mesh& mesh() const { return mesh_; }
   std::size_t collapses() const { return collapses_; }
   std::size_t flips() const { return flips_; }
@@ -359,7 +372,8 @@ class Cleaner {
             if (plan.flip || v != plan.kept) continue;
           }
           const Point q = CGAL::barycenter(t[0], double(a) / steps, t[1], double(b) / steps, t[2]);
-          if (!tree_.do_intersect(K::Sphere_3(q, bound2_))) return false;
+          if (!tree_.do_intersect(Plain::Sphere_3(Plain::Point_3(q.x(), q.y(), q.z()), bound2_)))
+            return false;
         }
       }
     }
@@ -487,7 +501,7 @@ class Cleaner {
     return Mesh::null_vertex();
   }
 
-  Mesh input_;
+  PlainMesh input_;
   Mesh mesh_;
   Tree tree_;
   double threshold_;
@@ -533,21 +547,10 @@ TriSurface to_surface(const Mesh& mesh) {
 
 // The measured deviation: an upper bound on the symmetric Hausdorff distance (CGAL's estimate,
 // which is a lower bound, plus its error bound), independent of the samples used by the local
-// checks. It runs on a plain double kernel: the surfaces share many
-// vertices exactly, and the filtered kernel's exact fallback for those touching cases costs more
-// than the whole cleanup.
+// checks.
 double measure_hausdorff(const TriSurface& a, const TriSurface& b, double error_bound) {
-  using Plain = CGAL::Simple_cartesian<double>;
-  using PlainMesh = CGAL::Surface_mesh<Plain::Point_3>;
-  auto convert = [](const TriSurface& s) {
-    PlainMesh m;
-    for (const Vec3& v : s.vertices) m.add_vertex(Plain::Point_3(v[0], v[1], v[2]));
-    for (const auto& t : s.triangles)
-      m.add_face(PlainMesh::Vertex_index(t[0]), PlainMesh::Vertex_index(t[1]), PlainMesh::Vertex_index(t[2]));
-    return m;
-  };
-  const PlainMesh ma = convert(a), mb = convert(b);
-  return PMP::bounded_error_symmetric_Hausdorff_distance<CGAL::Sequential_tag>(ma, mb, error_bound) +
+  return PMP::bounded_error_symmetric_Hausdorff_distance<CGAL::Sequential_tag>(
+             to_plain_mesh(a), to_plain_mesh(b), error_bound) +
          error_bound;
 }
 

@@ -72,7 +72,8 @@ void place_camera(vtkCamera* camera, const std::string& view) {
 
 }  // namespace
 
-void render_surface_png(const TriSurface& surface, const std::string& png_path, const RenderOptions& options) {
+void render_surface_png(const TriSurface& surface, const std::string& png_path,
+                        const RenderOptions& options) {
   vtkNew<vtkCamera> camera;
   place_camera(camera, options.view);  // validates the view before anything is opened
   if (!can_render())

@@ -11,8 +11,8 @@ namespace hexbite {
 struct RenderOptions {
   std::string view = "iso";  // iso | side | front | top | back
   int width = 1200, height = 800;
-  bool edges = true;         // draw the triangle or quad edges
-  std::string title;         // optional caption in the picture's corner
+  bool edges = true;  // draw the triangle or quad edges
+  std::string title;  // optional caption in the picture's corner
 };
 
 // True when VTK can open a window here: an X display is set. Rendering without one aborts inside

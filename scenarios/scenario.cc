@@ -390,8 +390,10 @@ LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, cons
 MeshSettings parse_mesh(const Value& v) {
   const Map map(v, {"method", "target_hexes", "validation_levels"});
   MeshSettings m;
-  if (auto x = map.find("method"))
+  if (auto x = map.find("method")) {
     m.method = to_choice<MeshMethod>(*x, {{"grid", MeshMethod::kGrid}, {"sheets", MeshMethod::kSheets}});
+    m.method_at = x->at;
+  }
   if (auto x = map.find("target_hexes")) {
     m.target_hexes = to_int(*x);
     if (m.target_hexes <= 0) fail(x->at, "mesh.target_hexes must be positive; the default is 2500");
@@ -582,18 +584,18 @@ Support parse_support(const Value& item) {
   return s;
 }
 
-SolverSettings parse_solver(const Value& v) {
+SolverSpec parse_solver(const Value& v) {
   const Map map(v, {"degree", "linear_solver", "tolerance", "max_iterations"});
-  SolverSettings s;
+  SolverSpec s;
   if (auto x = map.find("degree")) {
     s.degree = to_int(*x);
     if (s.degree != 1 && s.degree != 2)
       fail(x->at, "solver.degree is " + std::to_string(s.degree) + "; use 1 (Q1) or 2 (Q2)");
   }
   if (auto x = map.find("linear_solver"))
-    s.linear_solver = to_choice<LinearSolver>(
+    s.linear_solver = to_choice<LinearSolverChoice>(
         *x,
-        {{"auto", LinearSolver::kAuto}, {"cg_amg", LinearSolver::kCgAmg}, {"direct", LinearSolver::kDirect}});
+        {{"auto", LinearSolverChoice::kAuto}, {"cg_amg", LinearSolverChoice::kCgAmg}, {"direct", LinearSolverChoice::kDirect}});
   if (auto x = map.find("tolerance")) {
     s.tolerance = to_number(*x);
     if (s.tolerance <= 0 || s.tolerance >= 1)
@@ -822,7 +824,7 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
   }
 }
 
-Material material_at(const Materials& materials, const Vec3& x) {
+MaterialSpec material_at(const Materials& materials, const Vec3& x) {
   for (auto it = materials.regions.rbegin(); it != materials.regions.rend(); ++it) {
     const MaterialRegion& r = *it;
     const bool inside = r.shape == RegionShape::kSphere

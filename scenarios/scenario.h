@@ -66,9 +66,10 @@ struct MeshSettings {
   MeshMethod method = MeshMethod::kGrid;
   int target_hexes = 2500;
   int validation_levels = 1;  // each level is one 8-way refinement solved again
+  SourceLocation method_at;   // where `method` was written (empty when it was left at its default)
 };
 
-struct Material {
+struct MaterialSpec {
   double E_MPa = 11000;
   double poisson = 0.28;
 };
@@ -82,12 +83,12 @@ struct MaterialRegion {
   PointRef center;  // kSphere
   double radius_mm = 0;
   PointRef min, max;  // kBox: opposite corners, min below max in every coordinate
-  Material material;
+  MaterialSpec material;
   SourceLocation where;
 };
 
 struct Materials {
-  Material default_material;
+  MaterialSpec default_material;
   std::vector<MaterialRegion> regions;  // where regions overlap, the later one in the file wins
 };
 
@@ -114,11 +115,11 @@ struct Support {
   SourceLocation where;
 };
 
-enum class LinearSolver { kAuto, kCgAmg, kDirect };
+enum class LinearSolverChoice { kAuto, kCgAmg, kDirect };
 
-struct SolverSettings {
+struct SolverSpec {
   int degree = 1;
-  LinearSolver linear_solver = LinearSolver::kAuto;
+  LinearSolverChoice linear_solver = LinearSolverChoice::kAuto;
   double tolerance = 1e-10;  // relative residual
   int max_iterations = 10000;
 };
@@ -146,7 +147,7 @@ struct Scenario {
   Materials materials;
   std::vector<Muscle> muscles;  // the explicit list first, then the activation_pattern's muscles
   std::vector<Support> supports;
-  SolverSettings solver;
+  SolverSpec solver;
   Outputs outputs;
   std::vector<Probe> probes;
 };
@@ -163,7 +164,7 @@ Scenario load_scenario(const std::string& path);
 void resolve_points(Scenario& scenario, const Landmarks& landmarks);
 
 // The material at a point (after resolve_points): the last region containing it, else the default.
-Material material_at(const Materials& materials, const Vec3& x);
+MaterialSpec material_at(const Materials& materials, const Vec3& x);
 
 // A muscle's force vector in N (after resolve_points): activation x max force along the line of action.
 Vec3 muscle_force(const Muscle& muscle);

@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "mesher/hex_block.h"
 #include "mesher/hex_mesh.h"
 #include "solver/elasticity.h"
 
@@ -63,18 +64,7 @@ struct BoxGrid {
 inline BoxGrid box_grid(int nx, int ny, int nz, Vec3 lower, Vec3 upper) {
   BoxGrid g;
   g.nx = nx, g.ny = ny, g.nz = nz;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i)
-        g.mesh.vertices.push_back({lower[0] + (upper[0] - lower[0]) * i / nx,
-                                   lower[1] + (upper[1] - lower[1]) * j / ny,
-                                   lower[2] + (upper[2] - lower[2]) * k / nz});
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        g.mesh.hexes.push_back({g.vertex(i, j, k), g.vertex(i + 1, j, k), g.vertex(i + 1, j + 1, k),
-                                g.vertex(i, j + 1, k), g.vertex(i, j, k + 1), g.vertex(i + 1, j, k + 1),
-                                g.vertex(i + 1, j + 1, k + 1), g.vertex(i, j + 1, k + 1)});
+  g.mesh = make_block_mesh(nx, ny, nz, lower, upper);  // numbers vertices like BoxGrid::vertex()
   return g;
 }
 

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "mesher/hex_block.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
@@ -30,25 +31,9 @@ using test::run_hexbite;
 using test::temp_dir;
 using test::write_file;
 
-// An nx x ny x nz block of unit cubes, vertices numbered x fastest.
-HexMesh block(int nx, int ny, int nz) {
-  HexMesh mesh;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({double(i), double(j), double(k)});
-  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
-  return mesh;
-}
-
 // The block with every vertex moved by up to 0.2 and values that do not round-trip through short decimals.
 HexMesh perturbed_block(int nx, int ny, int nz) {
-  HexMesh mesh = block(nx, ny, nz);
+  HexMesh mesh = make_block_mesh(nx, ny, nz);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   for (Vec3& p : mesh.vertices)
@@ -109,7 +94,7 @@ TEST(HexMeshIo, VtuRoundTripWithArrays) {
 }
 
 TEST(HexMeshIo, VtuRejectsBadArrays) {
-  const HexMesh mesh = block(1, 1, 1);
+  const HexMesh mesh = make_block_mesh(1, 1, 1);
   const std::string path = temp_dir() + "/bad.vtu";
   EXPECT_THROW(write_vtu(path, mesh, {{"condition", 1, {1.0}}}), std::invalid_argument);
   EXPECT_THROW(write_vtu(path, mesh, {{"material", 1, {1.0, 2.0}}}), std::invalid_argument);
@@ -168,7 +153,7 @@ TEST(HexMeshIo, VtuReaderErrors) {
   EXPECT_NE(msg.find("NaN"), std::string::npos) << msg;
 
   // A truncated binary file: the header promises data that is not there.
-  write_vtu(dir + "/full.vtu", block(2, 2, 2));
+  write_vtu(dir + "/full.vtu", make_block_mesh(2, 2, 2));
   const std::string full = read_file(dir + "/full.vtu");
   write_file(dir + "/truncated.vtu", full.substr(0, full.size() / 2));
   msg = input_error_of([&] { read_vtu(dir + "/truncated.vtu"); });
@@ -299,7 +284,7 @@ Vec3 area_vector(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 }
 
 TEST(HexBoundary, BlockThreeByTwoByTwo) {
-  const HexMesh mesh = block(3, 2, 2);
+  const HexMesh mesh = make_block_mesh(3, 2, 2);
   const HexBoundary b = extract_boundary(mesh);
   // 2 (3x2) + 2 (3x2) + 2 (2x2) faces.
   ASSERT_EQ(b.surface.quads.size(), 32u);
@@ -345,7 +330,7 @@ TEST(HexBoundary, BlockThreeByTwoByTwo) {
 }
 
 TEST(HexBoundary, NonManifoldFaceIsAnError) {
-  HexMesh mesh = block(1, 1, 1);
+  HexMesh mesh = make_block_mesh(1, 1, 1);
   mesh.hexes.push_back(mesh.hexes[0]);
   mesh.hexes.push_back(mesh.hexes[0]);
   const std::string msg = input_error_of([&] { extract_boundary(mesh); });

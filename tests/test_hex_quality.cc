@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 
+#include "mesher/hex_block.h"
 #include "mesher/hex_quality.h"
 
 namespace hexbite {
@@ -211,24 +212,8 @@ TEST(HexQuality, CornerConditionSquaredMatchesKernel) {
   }
 }
 
-// An nx x ny x nz block of unit cubes, vertices numbered x fastest.
-HexMesh block(int nx, int ny, int nz) {
-  HexMesh mesh;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({double(i), double(j), double(k)});
-  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
-  return mesh;
-}
-
 TEST(HexQuality, SummaryOfABlock) {
-  HexMesh mesh = block(3, 3, 3);
+  HexMesh mesh = make_block_mesh(3, 3, 3);
   // Invert hex 0 as in the fixture: its corner 6 (the interior vertex at (1, 1, 1)) moves to its centre.
   mesh.vertices[mesh.hexes[0][6]] = {0.5, 0.5, 0.5};
   const QualitySummary s = summarize_quality(mesh);

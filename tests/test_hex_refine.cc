@@ -9,6 +9,7 @@
 #include <set>
 
 #include "mesher/grid_mesher.h"
+#include "mesher/hex_block.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
@@ -26,19 +27,7 @@ using test::temp_dir;
 
 // An nx x ny x nz block of cubes of edge h with its low corner at `origin`, vertices numbered x fastest.
 HexMesh block(int nx, int ny, int nz, double h = 1.0, Vec3 origin = {0, 0, 0}) {
-  HexMesh mesh;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i)
-        mesh.vertices.push_back({origin[0] + h * i, origin[1] + h * j, origin[2] + h * k});
-  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
-  return mesh;
+  return make_block_mesh(nx, ny, nz, origin, {origin[0] + h * nx, origin[1] + h * ny, origin[2] + h * nz});
 }
 
 // A closed, outward triangulated sphere of radius r: the boundary of an n^3 block, each quad split in two,

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "mesher/grid_mesher.h"
+#include "mesher/hex_block.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_reorder.h"
@@ -20,22 +21,6 @@ namespace {
 
 using test::run_hexbite;
 using test::temp_dir;
-
-// An nx x ny x nz block of unit cubes, vertices numbered x fastest.
-HexMesh block(int nx, int ny, int nz) {
-  HexMesh mesh;
-  for (int k = 0; k <= nz; ++k)
-    for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.vertices.push_back({double(i), double(j), double(k)});
-  const auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        mesh.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
-  return mesh;
-}
 
 // The block with its nodes and hexes randomly renumbered (a fixed seed): the worst case for bandwidth.
 HexMesh shuffled(const HexMesh& mesh, unsigned seed) {
@@ -93,13 +78,13 @@ void expect_permutation(const HexMesh& mesh, const ReorderResult& r) {
 }
 
 TEST(HexReorder, BothMethodsArePermutations) {
-  const HexMesh mesh = shuffled(block(6, 5, 4), 11);
+  const HexMesh mesh = shuffled(make_block_mesh(6, 5, 4), 11);
   expect_permutation(mesh, reorder_breadth_first(mesh, 17));
   expect_permutation(mesh, reorder_reverse_cuthill_mckee(mesh));
 }
 
 TEST(HexReorder, UnusedNodesGoLast) {
-  HexMesh mesh = block(2, 2, 2);
+  HexMesh mesh = make_block_mesh(2, 2, 2);
   mesh.vertices.insert(mesh.vertices.begin() + 3, Vec3{9, 9, 9});
   for (auto& hex : mesh.hexes)
     for (int& v : hex)
@@ -113,7 +98,7 @@ TEST(HexReorder, UnusedNodesGoLast) {
 TEST(HexReorder, ReverseCuthillMcKeeShrinksTheBandwidthOfAShuffledBlock) {
   // An elongated block, like a mandible: Cuthill-McKee's level sets are then cross-sections (6 x 7 x 7 nodes
   // at most two levels apart), while random numbering spreads neighbours over the whole range.
-  const HexMesh mesh = shuffled(block(30, 6, 6), 5);
+  const HexMesh mesh = shuffled(make_block_mesh(30, 6, 6), 5);
   const ReorderResult r = reorder_reverse_cuthill_mckee(mesh);
   expect_permutation(mesh, r);
   EXPECT_GT(r.before.bandwidth, 1400);
@@ -126,7 +111,7 @@ TEST(HexReorder, ReverseCuthillMcKeeShrinksTheBandwidthOfAShuffledBlock) {
 }
 
 TEST(HexReorder, ReportedBandwidthEqualsBruteForce) {
-  const HexMesh mesh = shuffled(block(5, 4, 3), 2);
+  const HexMesh mesh = shuffled(make_block_mesh(5, 4, 3), 2);
   const ReorderResult r = reorder_reverse_cuthill_mckee(mesh);
   const AdjacencyProfile before = brute_force_profile(mesh), after = brute_force_profile(r.mesh);
   EXPECT_EQ(r.before.bandwidth, before.bandwidth);
@@ -139,7 +124,7 @@ TEST(HexReorder, ReportedBandwidthEqualsBruteForce) {
 }
 
 TEST(HexReorder, BreadthFirstStartsAtTheBoundaryHexNearestThePoint) {
-  const HexMesh mesh = shuffled(block(6, 6, 6), 9);
+  const HexMesh mesh = shuffled(make_block_mesh(6, 6, 6), 9);
   // Boundary hexes by brute force: a hex with a face whose vertex set no other hex shares.
   std::vector<char> boundary(mesh.hexes.size(), 0);
   for (const auto& qf : extract_boundary(mesh).quad_face) boundary[qf[0]] = 1;
@@ -171,7 +156,7 @@ TEST(HexReorder, BreadthFirstStartsAtTheBoundaryHexNearestThePoint) {
 }
 
 TEST(HexReorder, Deterministic) {
-  const HexMesh mesh = shuffled(block(5, 5, 5), 4);
+  const HexMesh mesh = shuffled(make_block_mesh(5, 5, 5), 4);
   const ReorderResult a = reorder_reverse_cuthill_mckee(mesh), b = reorder_reverse_cuthill_mckee(mesh);
   EXPECT_EQ(a.node_order, b.node_order);
   EXPECT_EQ(a.hex_order, b.hex_order);
@@ -179,7 +164,7 @@ TEST(HexReorder, Deterministic) {
 
 TEST(HexReorderCommand, ReordersAndReports) {
   const std::string dir = temp_dir();
-  const HexMesh mesh = shuffled(block(6, 6, 6), 3);
+  const HexMesh mesh = shuffled(make_block_mesh(6, 6, 6), 3);
   write_vtu(dir + "/in.vtu", mesh);
   auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -208,7 +193,7 @@ TEST(HexReorderCommand, ReordersAndReports) {
 
 TEST(HexReorderCommand, BadInput) {
   const std::string dir = temp_dir();
-  write_vtu(dir + "/in.vtu", block(2, 2, 2));
+  write_vtu(dir + "/in.vtu", make_block_mesh(2, 2, 2));
   EXPECT_EQ(run_hexbite({"reorder", dir + "/missing.vtu", "-o", dir + "/o.vtu"}).exit_code, 2);
   auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/o.vtu", "--from", "1,2"});
   EXPECT_EQ(r.exit_code, 2);

@@ -104,7 +104,7 @@ TEST(Scenario, ValidBaseLoadsWithDefaults) {
   EXPECT_EQ(s.materials.default_material.E_MPa, 11000);
   EXPECT_EQ(s.materials.default_material.poisson, 0.28);
   EXPECT_EQ(s.solver.degree, 1);
-  EXPECT_EQ(s.solver.linear_solver, LinearSolver::kAuto);
+  EXPECT_EQ(s.solver.linear_solver, LinearSolverChoice::kAuto);
   EXPECT_EQ(s.solver.tolerance, 1e-10);
   EXPECT_TRUE(s.outputs.vtu);
   EXPECT_FALSE(s.outputs.inp);

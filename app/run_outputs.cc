@@ -1,0 +1,412 @@
+#include "app/run_outputs.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "mesher/hex_mesh_io.h"
+#include "postprocess/quality_json.h"
+#include "solver/mpi_session.h"
+
+namespace hexbite {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+json vec(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+// The figures of one level; results.json repeats them per level under validation.levels, and the top level
+// holds those of level 0 (the mesh of mesh.vtu, solution.vtu and model.inp).
+json level_figures(const Scenario& s, const LevelResult& l) {
+  const ElasticitySolution& u = l.solution;
+  json reactions = json::object();
+  for (const SupportReaction& r : u.reactions)
+    reactions[r.name] = {{"force_N", vec(r.force)}, {"magnitude_N", r.magnitude}, {"bite", r.is_bite}};
+  json probes = json::object();
+  for (std::size_t i = 0; i < s.probes.size(); ++i) {
+    const ProbeValue& p = u.probes[i];
+    probes[s.probes[i].name] = {{"at", vec(p.point)},
+                                {"found", p.found},
+                                {"displacement_mm", vec(p.displacement)},
+                                {"von_mises_MPa", p.von_mises}};
+  }
+  return {{"level", l.level},
+          {"hexes", l.mesh.hexes.size()},
+          {"nodes", l.mesh.vertices.size()},
+          {"dofs", u.dofs},
+          {"reactions", reactions},
+          {"bite_force_N", s.outputs.bite_force ? json(u.bite_force) : json()},
+          {"applied_force_N", vec(u.applied_force)},
+          {"equilibrium_residual", u.equilibrium_residual},
+          {"max_displacement_mm", u.max_displacement},
+          {"max_displacement_at", vec(u.max_displacement_at)},
+          {"von_mises_max_MPa", u.von_mises_max},
+          {"von_mises_p99_MPa", u.von_mises_p99},
+          {"von_mises_max_at", vec(u.von_mises_max_at)},
+          {"strain_energy_mJ", u.strain_energy},
+          {"probes", probes},
+          {"solver", {{"iterations", u.iterations}, {"seconds", u.seconds}, {"ranks", u.ranks}}}};
+}
+
+// (fine - coarse) / |fine| between the last two levels; null without a validation level.
+json relative_change(const RunResult& r, double (*figure)(const ElasticitySolution&)) {
+  if (r.levels.size() < 2) return json();
+  const double fine = figure(r.levels.back().solution);
+  const double coarse = figure(r.levels[r.levels.size() - 2].solution);
+  return fine == 0.0 ? json() : json((fine - coarse) / std::abs(fine));
+}
+
+// An Abaqus set name from a scenario name: letters, digits and '_' only, upper case (CalculiX folds case).
+std::string set_name(const std::string& prefix, const std::string& name) {
+  std::string out = prefix;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? std::toupper(c) : '_';
+  return out.substr(0, 80);
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::vector<int> patch_nodes(const MeshPatch& patch) {
+  std::vector<int> nodes;
+  for (const BoundaryQuad& q : patch.faces) nodes.insert(nodes.end(), q.begin(), q.end());
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
+// model_mesh.inp (nodes, elements, sets, via write_inp) and model.inp (material, supports, loads, step),
+// which includes the former. The loads are the consistent nodal forces of the muscles' uniform tractions,
+// the load vector the Q1 solver assembles, summed per node over all muscles.
+void write_inp_deck(const RunResult& r, const std::string& dir) {
+  const LevelResult& l = r.levels.front();
+  const Scenario& s = r.scenario;
+
+  // One element set per distinct material, in order of first appearance.
+  std::vector<Material> materials;
+  std::vector<IndexSet> element_sets;
+  for (std::size_t h = 0; h < l.hex_material.size(); ++h) {
+    const Material& m = l.hex_material[h];
+    std::size_t k = 0;
+    while (k < materials.size() && !(materials[k].youngs_modulus == m.youngs_modulus &&
+                                     materials[k].poisson_ratio == m.poisson_ratio))
+      ++k;
+    if (k == materials.size()) {
+      materials.push_back(m);
+      element_sets.push_back({"MAT_" + std::to_string(k + 1), {}});
+    }
+    element_sets[k].ids.push_back(static_cast<int>(h));
+  }
+  std::vector<IndexSet> node_sets;
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    node_sets.push_back({set_name("SUP_", s.supports[i].name), patch_nodes(l.support_patches[i])});
+  for (const MeshPatch& m : l.muscle_patches) node_sets.push_back({set_name("MUS_", m.name), patch_nodes(m)});
+  write_inp(dir + "/model_mesh.inp", l.mesh, node_sets, element_sets);
+
+  std::map<int, Vec3> loads;
+  for (std::size_t i = 0; i < l.muscle_patches.size(); ++i) {
+    const MeshPatch& m = l.muscle_patches[i];
+    const Vec3& f = l.muscle_forces[i];
+    const Vec3 traction{f[0] / m.area_mm2, f[1] / m.area_mm2, f[2] / m.area_mm2};
+    for (const auto& [node, force] : consistent_nodal_forces(l.mesh, m.faces, traction))
+      for (int d = 0; d < 3; ++d) loads.try_emplace(node, Vec3{0, 0, 0}).first->second[d] += force[d];
+  }
+
+  std::ostringstream out;
+  out << "** hexbite run: scenario " << s.name << ", the coarse mesh (level 0) with C3D8 elements\n"
+      << "** units: mm, N, MPa. Solve with: ccx -i model (in this folder)\n"
+      << "*INCLUDE, INPUT=model_mesh.inp\n";
+  for (std::size_t k = 0; k < materials.size(); ++k) {
+    const std::string name = element_sets[k].name;
+    out << "*MATERIAL, NAME=" << name << "\n*ELASTIC\n"
+        << num(materials[k].youngs_modulus) << ", " << num(materials[k].poisson_ratio) << '\n'
+        << "*SOLID SECTION, ELSET=" << name << ", MATERIAL=" << name << '\n';
+  }
+  out << "** fixed supports (zero displacement in the fixed components)\n*BOUNDARY\n";
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    for (int d = 0; d < 3; ++d)
+      if (s.supports[i].fixed[d]) out << node_sets[i].name << ", " << d + 1 << ", " << d + 1 << '\n';
+  out << "*STEP\n*STATIC\n** muscle loads: consistent nodal forces of the uniform tractions\n*CLOAD\n";
+  for (const auto& [node, f] : loads)
+    for (int d = 0; d < 3; ++d)
+      if (f[d] != 0.0) out << node + 1 << ", " << d + 1 << ", " << num(f[d]) << '\n';
+  out << "*NODE PRINT, NSET=NALL\nU\n";
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    out << "*NODE PRINT, NSET=" << node_sets[i].name << ", TOTALS=ONLY\nRF\n";
+  out << "*END STEP\n";
+  write_file_atomically(dir + "/model.inp", out.str());
+}
+
+// The solution arrays of a level, on its whole mesh.
+void solution_arrays(const LevelResult& l, std::vector<MeshArray>* cells,
+                     std::vector<MeshArray>* points) {
+  const ElasticitySolution& u = l.solution;
+  const std::size_t n = l.mesh.vertices.size(), m = l.mesh.hexes.size();
+  MeshArray displacement{"displacement", 3, {}}, vm_point{"von_mises", 1, u.vertex_von_mises};
+  for (const Vec3& d : u.vertex_displacement) displacement.values.insert(displacement.values.end(), d.begin(), d.end());
+  // Patch membership: the index of the support (muscle) in the scenario's order, -1 elsewhere; a node on
+  // two patches shows the later one.
+  MeshArray support_id{"support_id", 1, std::vector<double>(n, -1.0)};
+  MeshArray muscle_id{"muscle_id", 1, std::vector<double>(n, -1.0)};
+  for (std::size_t i = 0; i < l.support_patches.size(); ++i)
+    for (int v : patch_nodes(l.support_patches[i])) support_id.values[v] = static_cast<double>(i);
+  for (std::size_t i = 0; i < l.muscle_patches.size(); ++i)
+    for (int v : patch_nodes(l.muscle_patches[i])) muscle_id.values[v] = static_cast<double>(i);
+  *points = {displacement, vm_point, support_id, muscle_id};
+
+  MeshArray stress{"stress", 6, {}}, principal{"principal_stress", 3, {}};
+  MeshArray E{"E_MPa", 1, {}}, nu{"poisson", 1, {}};
+  for (std::size_t h = 0; h < m; ++h) {
+    stress.values.insert(stress.values.end(), u.hex_stress[h].begin(), u.hex_stress[h].end());
+    principal.values.insert(principal.values.end(), u.hex_principal_stress[h].begin(),
+                            u.hex_principal_stress[h].end());
+    E.values.push_back(l.hex_material[h].youngs_modulus);
+    nu.values.push_back(l.hex_material[h].poisson_ratio);
+  }
+  *cells = {{"von_mises", 1, u.hex_von_mises}, {"von_mises_max", 1, u.hex_von_mises_max}, stress, principal, E, nu};
+}
+
+// Piece `rank` of `ranks`: the contiguous block of hexes [m rank / ranks, m (rank + 1) / ranks) on the
+// vertices they use (renumbered in ascending order), with the arrays sliced to match.
+void slice(const HexMesh& mesh, int rank, int ranks, std::vector<MeshArray>* cells, std::vector<MeshArray>* points,
+           HexMesh* piece) {
+  const std::size_t m = mesh.hexes.size();
+  const std::size_t first = m * rank / ranks, last = m * (rank + 1) / ranks;
+  std::vector<int> new_id(mesh.vertices.size(), -1);
+  for (std::size_t h = first; h < last; ++h)
+    for (int v : mesh.hexes[h]) new_id[v] = 0;
+  std::vector<int> old_id;
+  for (std::size_t v = 0; v < new_id.size(); ++v)
+    if (new_id[v] == 0) {
+      new_id[v] = static_cast<int>(old_id.size());
+      old_id.push_back(static_cast<int>(v));
+    }
+  piece->vertices.clear();
+  piece->hexes.clear();
+  for (int v : old_id) piece->vertices.push_back(mesh.vertices[v]);
+  for (std::size_t h = first; h < last; ++h) {
+    std::array<int, 8> hex;
+    for (int k = 0; k < 8; ++k) hex[k] = new_id[mesh.hexes[h][k]];
+    piece->hexes.push_back(hex);
+  }
+  for (MeshArray& a : *cells)
+    a.values = std::vector<double>(a.values.begin() + first * a.components, a.values.begin() + last * a.components);
+  for (MeshArray& a : *points) {
+    std::vector<double> values;
+    for (int v : old_id) values.insert(values.end(), a.values.begin() + v * a.components,
+                                       a.values.begin() + (v + 1) * a.components);
+    a.values = std::move(values);
+  }
+}
+
+// The .pvtu that ties the pieces together (the arrays' names and sizes, the pieces' file names).
+std::string pvtu_text(const std::vector<MeshArray>& cells, const std::vector<MeshArray>& points,
+                      const std::vector<std::string>& pieces) {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" "
+         "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  out << "    <PPointData>\n";
+  for (const MeshArray& a : points)
+    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\"" << a.components
+        << "\"/>\n";
+  out << "    </PPointData>\n    <PCellData>\n";
+  for (const char* name : kVtuQualityArrays)
+    out << "      <PDataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"1\"/>\n";
+  for (const MeshArray& a : cells)
+    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\"" << a.components
+        << "\"/>\n";
+  out << "    </PCellData>\n    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
+         "    </PPoints>\n";
+  for (const std::string& p : pieces) out << "    <Piece Source=\"" << p << "\"/>\n";
+  out << "  </PUnstructuredGrid>\n</VTKFile>\n";
+  return out.str();
+}
+
+// Writes the solution of one level as DIR/STEM.vtu (one rank) or DIR/STEM.pvtu with pieces
+// DIR/STEM_<rank>.vtu written by each rank (several ranks). Returns the files written (rank 0's view).
+std::vector<std::string> write_solution(const LevelResult& l, const std::string& dir,
+                                        const std::string& stem) {
+  std::vector<MeshArray> cells, points;
+  solution_arrays(l, &cells, &points);
+  const int rank = MpiSession::rank(), ranks = MpiSession::size();
+  if (ranks == 1) {
+    write_vtu(dir + "/" + stem + ".vtu", l.mesh, cells, points);
+    return {stem + ".vtu"};
+  }
+  std::vector<std::string> pieces;
+  for (int p = 0; p < ranks; ++p) pieces.push_back(stem + "_" + std::to_string(p) + ".vtu");
+  const std::vector<MeshArray> all_cells = cells, all_points = points;
+  HexMesh piece;
+  slice(l.mesh, rank, ranks, &cells, &points, &piece);
+  write_vtu(dir + "/" + pieces[rank], piece, cells, points);
+  if (rank != 0) return {};
+  write_file_atomically(dir + "/" + stem + ".pvtu", pvtu_text(all_cells, all_points, pieces));
+  pieces.insert(pieces.begin(), stem + ".pvtu");
+  return pieces;
+}
+
+double bite_force(const ElasticitySolution& u) { return u.bite_force; }
+double max_displacement(const ElasticitySolution& u) { return u.max_displacement; }
+double strain_energy(const ElasticitySolution& u) { return u.strain_energy; }
+
+}  // namespace
+
+void check_inp_exportable(const Scenario& scenario) {
+  for (const Support& s : scenario.supports)
+    if (s.spring_N_per_mm3)
+      throw InputError(s.where.str() + ": support '" + s.name +
+                       "' is a spring (spring_N_per_mm3), which the CalculiX export does not write; "
+                       "use fixed components for the comparison with CalculiX, or run without --export inp");
+}
+
+json results_json(const RunResult& r, double seconds_output) {
+  const Scenario& s = r.scenario;
+  const LevelResult& coarse = r.levels.front();
+  json j = level_figures(s, coarse);
+  j.erase("level");
+  j.erase("hexes");
+  j.erase("nodes");
+  j.erase("dofs");
+  j["scenario"] = s.name;
+  j["scenario_file"] = s.path;
+  const MeshFidelity& f = r.fidelity;
+  j["mesh"] = {{"hexes", coarse.mesh.hexes.size()},
+               {"nodes", coarse.mesh.vertices.size()},
+               {"dofs", coarse.solution.dofs},
+               {"degree", s.solver.degree},
+               {"quality", quality_to_json(coarse.quality)},
+               {"fidelity",
+                {{"hausdorff_mm", f.hausdorff},
+                 {"hausdorff_mesh_to_surface_mm", f.hausdorff_mesh_to_surface},
+                 {"hausdorff_surface_to_mesh_mm", f.hausdorff_surface_to_mesh},
+                 {"mesh_volume_mm3", f.mesh_volume},
+                 {"surface_volume_mm3", f.surface_volume},
+                 {"volume_difference", f.volume_difference}}}};
+  json muscles = json::array();
+  for (std::size_t i = 0; i < coarse.muscle_patches.size(); ++i)
+    muscles.push_back({{"name", coarse.muscle_patches[i].name},
+                       {"force_N", vec(coarse.muscle_forces[i])},
+                       {"magnitude_N", norm(coarse.muscle_forces[i])},
+                       {"patch_area_mm2", coarse.muscle_patches[i].area_mm2},
+                       {"facets", coarse.muscle_patches[i].faces.size()}});
+  j["muscles"] = muscles;
+  json supports = json::array();
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    supports.push_back({{"name", s.supports[i].name},
+                        {"patch_area_mm2", coarse.support_patches[i].area_mm2},
+                        {"facets", coarse.support_patches[i].faces.size()}});
+  j["supports"] = supports;
+  json levels = json::array();
+  for (const LevelResult& l : r.levels) levels.push_back(level_figures(s, l));
+  j["validation"] = {{"levels", levels},
+                     {"relative_change",
+                      {{"bite_force", relative_change(r, bite_force)},
+                       {"max_displacement", relative_change(r, max_displacement)},
+                       {"strain_energy", relative_change(r, strain_energy)}}}};
+  json mesh_seconds = json::array(), solve_seconds = json::array();
+  for (const LevelResult& l : r.levels) {
+    mesh_seconds.push_back(l.seconds_mesh);
+    solve_seconds.push_back(l.seconds_solve);
+  }
+  j["seconds"] = {{"geometry", r.seconds_geometry},
+                  {"mesh_per_level", mesh_seconds},
+                  {"solve_per_level", solve_seconds},
+                  {"output", seconds_output},
+                  {"total", r.seconds_total + seconds_output}};
+  return j;
+}
+
+std::vector<std::string> write_run_outputs(const RunResult& r, const std::string& dir, bool export_inp) {
+  const bool vtu = r.scenario.outputs.vtu;
+  const int rank = MpiSession::rank();
+  std::vector<std::string> written;
+  if (rank == 0) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw RunError("cannot create the output folder '" + dir + "': " + ec.message());
+  }
+  // The pieces of a distributed run are written into the folder rank 0 just created.
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (rank == 0) {
+    if (vtu) {
+      write_vtu(dir + "/mesh.vtu", r.levels.front().mesh);
+      written.push_back("mesh.vtu");
+    }
+    if (export_inp) {
+      write_inp_deck(r, dir);
+      written.insert(written.end(), {"model.inp", "model_mesh.inp"});
+    }
+  }
+  for (const LevelResult& l : r.levels) {
+    if (!vtu) break;
+    const std::string stem = l.level == 0 ? "solution" : "solution_level" + std::to_string(l.level);
+    const std::vector<std::string> files = write_solution(l, dir, stem);
+    written.insert(written.end(), files.begin(), files.end());
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  return written;
+}
+
+std::string summary_table(const RunResult& r) {
+  std::ostringstream out;
+  char line[256];
+  const auto row = [&](const char* label, const char* format, auto value) {
+    std::snprintf(line, sizeof line, "%-28s", label);
+    out << line;
+    for (const LevelResult& l : r.levels) {
+      std::snprintf(line, sizeof line, format, value(l));
+      out << line;
+    }
+    out << '\n';
+  };
+  std::snprintf(line, sizeof line, "%-28s", "level");
+  out << line;
+  for (const LevelResult& l : r.levels) {
+    std::snprintf(line, sizeof line, "%14d", l.level);
+    out << line;
+  }
+  out << '\n';
+  row("hexes", "%14zu", [](const LevelResult& l) { return l.mesh.hexes.size(); });
+  row("degrees of freedom", "%14lld", [](const LevelResult& l) { return l.solution.dofs; });
+  if (r.scenario.outputs.bite_force)
+    row("bite force (N)", "%14.2f", [](const LevelResult& l) { return l.solution.bite_force; });
+  for (std::size_t i = 0; i < r.scenario.supports.size(); ++i) {
+    const std::string label = "reaction " + r.scenario.supports[i].name + " (N)";
+    row(label.c_str(), "%14.2f", [i](const LevelResult& l) { return l.solution.reactions[i].magnitude; });
+  }
+  row("max displacement (mm)", "%14.5f", [](const LevelResult& l) { return l.solution.max_displacement; });
+  row("von Mises max (MPa)", "%14.3f", [](const LevelResult& l) { return l.solution.von_mises_max; });
+  row("von Mises p99 (MPa)", "%14.3f", [](const LevelResult& l) { return l.solution.von_mises_p99; });
+  row("strain energy (mJ)", "%14.5f", [](const LevelResult& l) { return l.solution.strain_energy; });
+  row("equilibrium residual", "%14.2e", [](const LevelResult& l) { return l.solution.equilibrium_residual; });
+  row("CG iterations (0 = direct)", "%14d", [](const LevelResult& l) { return l.solution.iterations; });
+  row("solve seconds", "%14.2f", [](const LevelResult& l) { return l.solution.seconds; });
+  if (r.levels.size() >= 2) {
+    const int last = r.levels.back().level;
+    out << "relative change, level " << last << " against " << last - 1 << ": bite force ";
+    const auto pct = [&](double (*figure)(const ElasticitySolution&)) {
+      const json c = relative_change(r, figure);
+      std::snprintf(line, sizeof line, "%+.2f %%", c.is_null() ? 0.0 : 100.0 * c.get<double>());
+      return std::string(line);
+    };
+    out << pct(bite_force) << ", max displacement " << pct(max_displacement) << ", strain energy "
+        << pct(strain_energy) << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace hexbite

@@ -1,0 +1,283 @@
+#include "app/run_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "common/error.h"
+#include "common/progress.h"
+#include "mesher/ct_surface.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_refine.h"
+#include "mesher/landmarks.h"
+#include "mesher/mandible_generator.h"
+#include "mesher/surface_check.h"
+#include "mesher/surface_projector.h"
+
+namespace hexbite {
+
+namespace {
+
+// Below this many degrees of freedom `linear_solver: auto` factorizes (MUMPS): on this machine that is
+// faster than setting up the AMG hierarchy, and above it the factorization's fill-in makes CG + AMG win.
+constexpr long long kDirectSolverMaxDofs = 30000;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+struct Geometry {
+  TriSurface surface;
+  Landmarks landmarks;
+};
+
+Geometry build_geometry(const Scenario& s) {
+  Geometry g;
+  switch (s.geometry.source) {
+    case GeometrySource::kMandible: {
+      GeneratedMandible m = generate_mandible(s.geometry.mandible);
+      g.surface = std::move(m.surface);
+      g.landmarks = std::move(m.landmarks);
+      break;
+    }
+    case GeometrySource::kSurface:
+      g.surface = load_closed_surface(s.geometry.file, s.geometry.scale_to_mm);
+      break;
+    case GeometrySource::kCt: {
+      g.surface = surface_from_volume(read_volume(s.geometry.file), s.geometry.threshold);
+      // Marching cubes gives a closed surface by construction, but the same checks as for a surface file
+      // catch a threshold that produced something that cannot bound a solid.
+      const SurfaceReport report = check_surface(g.surface, s.geometry.file);
+      if (!report.usable())
+        throw InputError(s.geometry.where.str() + ": the surface of " + s.geometry.file + " at threshold " +
+                         std::to_string(s.geometry.threshold) +
+                         " cannot bound a solid: " + report.problems.front() + "; try another threshold");
+      break;
+    }
+  }
+  if (!s.landmarks.file.empty()) g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
+  return g;
+}
+
+// Degrees of freedom of vector FE_Q(degree) on the mesh: 3 per vertex, and for Q2 also 3 per edge, face and
+// hex (the support points of the triquadratic element).
+long long count_dofs(const HexMesh& mesh, int degree) {
+  long long nodes = static_cast<long long>(mesh.vertices.size());
+  if (degree == 2) {
+    static constexpr int kEdges[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                          {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    std::vector<std::array<int, 2>> edges;
+    std::vector<std::array<int, 4>> faces;
+    edges.reserve(12 * mesh.hexes.size());
+    faces.reserve(6 * mesh.hexes.size());
+    for (const auto& hex : mesh.hexes) {
+      for (const auto& e : kEdges) edges.push_back({std::min(hex[e[0]], hex[e[1]]), std::max(hex[e[0]], hex[e[1]])});
+      for (const auto& f : kHexFaces) {
+        std::array<int, 4> key{hex[f[0]], hex[f[1]], hex[f[2]], hex[f[3]]};
+        std::sort(key.begin(), key.end());
+        faces.push_back(key);
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    std::sort(faces.begin(), faces.end());
+    nodes += std::unique(edges.begin(), edges.end()) - edges.begin();
+    nodes += std::unique(faces.begin(), faces.end()) - faces.begin();
+    nodes += static_cast<long long>(mesh.hexes.size());
+  }
+  return 3 * nodes;
+}
+
+// Calls f(shape function values at the 4 corners, |x_u x x_v| times the Gauss weight) at the 2 x 2 Gauss
+// points of the bilinear quad through the four vertices.
+template <typename F>
+void for_each_gauss_point(const HexMesh& mesh, const BoundaryQuad& quad, F&& f) {
+  const double g = 0.5 / std::sqrt(3.0);
+  for (double u : {0.5 - g, 0.5 + g})
+    for (double v : {0.5 - g, 0.5 + g}) {
+      // Corners in order around the quad: (0,0), (1,0), (1,1), (0,1) on the unit square, weights 1/4.
+      const std::array<double, 4> N{(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
+      const std::array<double, 4> Nu{-(1 - v), 1 - v, v, -v};
+      const std::array<double, 4> Nv{-(1 - u), -u, u, 1 - u};
+      Vec3 xu{0, 0, 0}, xv{0, 0, 0};
+      for (int a = 0; a < 4; ++a)
+        for (int d = 0; d < 3; ++d) {
+          xu[d] += Nu[a] * mesh.vertices[quad[a]][d];
+          xv[d] += Nv[a] * mesh.vertices[quad[a]][d];
+        }
+      const Vec3 n{xu[1] * xv[2] - xu[2] * xv[1], xu[2] * xv[0] - xu[0] * xv[2], xu[0] * xv[1] - xu[1] * xv[0]};
+      f(N, 0.25 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]));
+    }
+}
+
+// The boundary quads that a scenario patch selects, as mesh vertex ids.
+MeshPatch select_patch(const HexMesh& mesh, const HexBoundary& boundary, const std::string& name,
+                       const Vec3& center, double radius, const SourceLocation& where, const std::string& what) {
+  MeshPatch patch;
+  patch.name = name;
+  for (int q : require_patch_quads(boundary.surface, center, radius, where, what)) {
+    const auto& quad = boundary.surface.quads[q];
+    patch.faces.push_back({boundary.boundary_vertices[quad[0]], boundary.boundary_vertices[quad[1]],
+                           boundary.boundary_vertices[quad[2]], boundary.boundary_vertices[quad[3]]});
+  }
+  patch.area_mm2 = patch_area(mesh, patch.faces);
+  return patch;
+}
+
+// Everything of a level that depends only on its mesh: quality, patches and materials.
+LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
+  LevelResult r;
+  r.level = level;
+  r.mesh = std::move(mesh);
+  r.quality = summarize_quality(r.mesh);
+  const HexBoundary boundary = extract_boundary(r.mesh);
+  for (const Muscle& m : s.muscles) {
+    if (m.activation <= 0) continue;
+    r.muscle_patches.push_back(select_patch(r.mesh, boundary, m.name, m.insertion.xyz, m.radius_mm, m.where,
+                                            "the insertion patch of muscle '" + m.name + "'"));
+    r.muscle_forces.push_back(muscle_force(m));
+  }
+  for (const Support& sup : s.supports)
+    r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm, sup.where,
+                                             "support '" + sup.name + "'"));
+  r.hex_material.reserve(r.mesh.hexes.size());
+  for (const auto& hex : r.mesh.hexes) {
+    Vec3 c{0, 0, 0};
+    for (int v : hex)
+      for (int d = 0; d < 3; ++d) c[d] += r.mesh.vertices[v][d] / 8.0;
+    const MaterialSpec m = material_at(s.materials, c);
+    r.hex_material.push_back({m.E_MPa, m.poisson});
+  }
+  return r;
+}
+
+void solve_level(const Scenario& s, LevelResult& r) {
+  ElasticityProblem p;
+  p.mesh = &r.mesh;
+  p.hex_material = r.hex_material;
+  for (std::size_t i = 0; i < r.muscle_patches.size(); ++i)
+    p.loads.push_back({r.muscle_patches[i].name, r.muscle_patches[i].faces, r.muscle_forces[i]});
+  for (std::size_t i = 0; i < s.supports.size(); ++i) {
+    const Support& sup = s.supports[i];
+    SupportPatch patch;
+    patch.name = sup.name;
+    patch.faces = r.support_patches[i].faces;
+    patch.is_bite = sup.bite;
+    if (sup.spring_N_per_mm3) {
+      patch.spring_stiffness = *sup.spring_N_per_mm3;  // an elastic foundation acts on all components
+    } else {
+      patch.components = sup.fixed;
+    }
+    p.supports.push_back(std::move(patch));
+  }
+  for (const Probe& probe : s.probes) p.probes.push_back(probe.at.xyz);
+  p.degree = s.solver.degree;
+  const long long dofs = count_dofs(r.mesh, s.solver.degree);
+  switch (s.solver.linear_solver) {
+    case LinearSolverChoice::kAuto:
+      p.solver.linear_solver = dofs < kDirectSolverMaxDofs ? LinearSolver::kDirect : LinearSolver::kCgAmg;
+      break;
+    case LinearSolverChoice::kCgAmg:
+      p.solver.linear_solver = LinearSolver::kCgAmg;
+      break;
+    case LinearSolverChoice::kDirect:
+      p.solver.linear_solver = LinearSolver::kDirect;
+      break;
+  }
+  p.solver.relative_tolerance = s.solver.tolerance;
+  p.solver.max_iterations = s.solver.max_iterations;
+
+  Progress progress("solve level " + std::to_string(r.level));
+  const auto start = std::chrono::steady_clock::now();
+  r.solution = solve_elasticity(p);
+  r.seconds_solve = seconds_since(start);
+  progress.finish(std::to_string(r.solution.dofs) + " DoFs");
+}
+
+}  // namespace
+
+double patch_area(const HexMesh& mesh, const std::vector<BoundaryQuad>& faces) {
+  double area = 0.0;
+  for (const BoundaryQuad& quad : faces)
+    for_each_gauss_point(mesh, quad, [&](const std::array<double, 4>&, double da) { area += da; });
+  return area;
+}
+
+std::vector<std::pair<int, Vec3>> consistent_nodal_forces(const HexMesh& mesh,
+                                                          const std::vector<BoundaryQuad>& faces,
+                                                          const Vec3& traction) {
+  std::map<int, Vec3> forces;
+  for (const BoundaryQuad& quad : faces)
+    for_each_gauss_point(mesh, quad, [&](const std::array<double, 4>& N, double da) {
+      for (int a = 0; a < 4; ++a) {
+        Vec3& f = forces.try_emplace(quad[a], Vec3{0, 0, 0}).first->second;
+        for (int d = 0; d < 3; ++d) f[d] += N[a] * traction[d] * da;
+      }
+    });
+  return {forces.begin(), forces.end()};
+}
+
+RunResult run_pipeline(Scenario scenario, int levels) {
+  const auto start = std::chrono::steady_clock::now();
+  RunResult result;
+  if (scenario.mesh.method == MeshMethod::kSheets)
+    throw InputError((scenario.mesh.method_at.file.empty() ? scenario.path : scenario.mesh.method_at.str()) +
+                     ": mesh.method 'sheets' (the seed paper's cycle elimination) is not available yet; use "
+                     "method: grid");
+
+  Geometry geometry;
+  {
+    Progress progress("geometry");
+    geometry = build_geometry(scenario);
+    resolve_points(scenario, geometry.landmarks);
+    result.seconds_geometry = seconds_since(start);
+    progress.finish(std::to_string(geometry.surface.triangles.size()) + " triangles");
+  }
+
+  // Level 0: the coarse mesh. A mesh that stays inverted cannot be solved on; say where.
+  HexMesh coarse;
+  double seconds_mesh = 0.0;
+  {
+    Progress progress("mesh");
+    const auto t = std::chrono::steady_clock::now();
+    GridMeshOptions options;
+    options.target_hexes = scenario.mesh.target_hexes;
+    GridMeshReport report;
+    coarse = grid_mesh(geometry.surface, options, &report);
+    seconds_mesh = seconds_since(t);
+    result.fidelity = report.fidelity;
+    if (report.optimize.inverted > 0)
+      throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
+                     " inverted hexes at mesh.target_hexes = " + std::to_string(scenario.mesh.target_hexes) +
+                     "; try another target (hexbite mesh shows where)");
+    progress.finish(std::to_string(coarse.hexes.size()) + " hexes");
+  }
+  result.levels.push_back(prepare_level(scenario, 0, coarse));
+  result.levels.back().seconds_mesh = seconds_mesh;
+
+  // Every patch of every level is selected before the first solve, so a scenario error never costs a solve.
+  std::unique_ptr<SurfaceProjector> projector;
+  if (levels > 0) projector = std::make_unique<SurfaceProjector>(geometry.surface);
+  for (int level = 1; level <= levels; ++level) {
+    Progress progress("refine level " + std::to_string(level));
+    const auto t = std::chrono::steady_clock::now();
+    RefineReport report;
+    HexMesh fine = refine_to_surface(result.levels.back().mesh, projector.get(), RefineOptions{}, &report);
+    if (report.after.inverted > 0)
+      throw RunError("refinement level " + std::to_string(level) + " left " +
+                     std::to_string(report.after.inverted) +
+                     " inverted hexes; run with fewer validation levels (--levels) or another target_hexes");
+    const double seconds = seconds_since(t);
+    result.levels.push_back(prepare_level(scenario, level, std::move(fine)));
+    result.levels.back().seconds_mesh = seconds;
+    progress.finish(std::to_string(result.levels.back().mesh.hexes.size()) + " hexes");
+  }
+
+  for (LevelResult& level : result.levels) solve_level(scenario, level);
+  result.scenario = std::move(scenario);
+  result.seconds_total = seconds_since(start);
+  return result;
+}
+
+}  // namespace hexbite

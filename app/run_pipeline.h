@@ -1,0 +1,68 @@
+// The end-to-end bite simulation behind `hexbite run`: scenario -> geometry and landmarks -> hex mesh ->
+// boundary patches -> per-hex materials -> elasticity solve -> validation levels (the mesh refined 8-way onto
+// the surface, the patches selected again with the same centres and radii, solved again).
+//
+// Input: a loaded Scenario (scenarios/scenario.h) and the number of validation levels.
+// Output: one LevelResult per level (level 0 is the coarse mesh) with the mesh, the patches, the problem's
+// materials and the solution, plus the geometry's fidelity and the stage timings. Nothing is written here:
+// app/run_outputs.h turns a RunResult into results.json, VTU files and the CalculiX deck.
+// Errors: InputError for anything the scenario got wrong (with its file and line), before the first solve;
+// RunError when a mesh stays inverted or the linear solver fails.
+// MPI: collective. Every rank builds the same geometry and meshes (all steps are deterministic) and calls the
+// solver together; every rank receives the complete solution.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "mesher/grid_mesher.h"
+#include "mesher/hex_mesh.h"
+#include "mesher/hex_quality.h"
+#include "scenarios/scenario.h"
+#include "solver/elasticity.h"
+
+namespace hexbite {
+
+// The boundary faces of one scenario patch on one mesh, as mesh vertex ids (outward, counter-clockwise).
+struct MeshPatch {
+  std::string name;
+  std::vector<BoundaryQuad> faces;
+  double area_mm2 = 0.0;  // with the solver's 2 x 2 Gauss rule on the bilinear quads
+};
+
+struct LevelResult {
+  int level = 0;  // 0 = the coarse mesh, k = refined k times
+  HexMesh mesh;
+  QualitySummary quality;
+  std::vector<MeshPatch> muscle_patches;  // the muscles with activation > 0, in scenario order
+  std::vector<Vec3> muscle_forces;        // N, total force of each of those muscles
+  std::vector<MeshPatch> support_patches;  // every support, in scenario order
+  std::vector<Material> hex_material;      // one per hex
+  ElasticitySolution solution;
+  double seconds_mesh = 0.0;   // meshing (level 0) or refinement (levels > 0)
+  double seconds_solve = 0.0;  // the solver call
+};
+
+struct RunResult {
+  Scenario scenario;  // with every point resolved
+  MeshFidelity fidelity;  // of the coarse mesh against the bone surface
+  std::vector<LevelResult> levels;
+  double seconds_geometry = 0.0;
+  double seconds_total = 0.0;
+};
+
+// The consistent nodal forces of a uniform traction on bilinear quads: for every quad, the integral of each
+// corner's shape function times the traction, by the 2 x 2 Gauss rule (what the Q1 solver assembles).
+// Returns one (vertex id, force) entry per vertex touched, sorted by vertex id, with `traction` in MPa.
+std::vector<std::pair<int, Vec3>> consistent_nodal_forces(const HexMesh& mesh,
+                                                          const std::vector<BoundaryQuad>& faces,
+                                                          const Vec3& traction);
+
+// The area of a patch of bilinear quads by the same 2 x 2 Gauss rule.
+double patch_area(const HexMesh& mesh, const std::vector<BoundaryQuad>& faces);
+
+// Runs the pipeline. `levels` validation levels follow the coarse solve. Throws as described above.
+RunResult run_pipeline(Scenario scenario, int levels);
+
+}  // namespace hexbite
