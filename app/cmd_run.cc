@@ -56,9 +56,9 @@ void run_run(const RunCliOptions& o) {
   if (root && o.json) {
     std::cout << results.dump(2) << '\n';
   } else if (root && !is_quiet()) {
-    std::cout << "Scenario " << result.scenario.name << " (" << o.scenario << "), " << result.levels.size() - 1
-              << " validation level" << (result.levels.size() == 2 ? "" : "s") << ", " << MpiSession::size()
-              << " rank" << (MpiSession::size() == 1 ? "" : "s") << "\n\n"
+    std::cout << "Scenario " << result.scenario.name << " (" << o.scenario << "), "
+              << result.levels.size() - 1 << " validation level" << (result.levels.size() == 2 ? "" : "s")
+              << ", " << MpiSession::size() << " rank" << (MpiSession::size() == 1 ? "" : "s") << "\n\n"
               << summary_table(result) << '\n';
     std::cout << "wrote in " << o.output << ": results.json";
     for (const std::string& f : files) std::cout << ", " << f;
@@ -84,9 +84,10 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output folder (created if missing)")->required();
   cmd->add_option("--export", o->export_format, "Also write the model for another solver: inp (CalculiX)")
       ->check(CLI::IsMember({"inp"}));
-  cmd->add_option("--levels", o->levels,
-                  "Validation levels (each refines the mesh 8-way and solves again); overrides the scenario's "
-                  "mesh.validation_levels")
+  cmd->add_option(
+         "--levels", o->levels,
+         "Validation levels (each refines the mesh 8-way and solves again); overrides the scenario's "
+         "mesh.validation_levels")
       ->check(CLI::Range(0, 3));
   cmd->add_flag("--json", o->json, "Print results.json instead of the summary table");
   cmd->callback([o] { run_run(*o); });

@@ -23,8 +23,7 @@ int main(int argc, char** argv) {
   CLI::App app{"hexbite: hexahedral meshing and bite simulation of the human mandible"};
   app.set_version_flag("--version", std::string("hexbite ") + HEXBITE_VERSION);
   bool quiet = false;
-  app.add_flag("-q,--quiet", quiet, "No progress display and no informational output")
-      ->configurable(false);
+  app.add_flag("-q,--quiet", quiet, "No progress display and no informational output")->configurable(false);
   app.require_subcommand(1);
   app.fallthrough();  // --quiet may follow the subcommand
   app.parse_complete_callback([&] { hexbite::set_quiet(quiet || !root); });

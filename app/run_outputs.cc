@@ -23,9 +23,13 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-json vec(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+json vec(const Vec3& v) {
+  return json::array({v[0], v[1], v[2]});
+}
 
-double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+double norm(const Vec3& v) {
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
 
 // The figures of one level; results.json repeats them per level under validation.levels, and the top level
 // holds those of level 0 (the mesh of mesh.vtu, solution.vtu and model.inp).
@@ -73,12 +77,6 @@ std::string set_name(const std::string& prefix, const std::string& name) {
   std::string out = prefix;
   for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? std::toupper(c) : '_';
   return out.substr(0, 80);
-}
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
 }
 
 std::vector<int> patch_nodes(const MeshPatch& patch) {
@@ -133,7 +131,8 @@ void write_inp_deck(const RunResult& r, const std::string& dir) {
   for (std::size_t k = 0; k < materials.size(); ++k) {
     const std::string name = element_sets[k].name;
     out << "*MATERIAL, NAME=" << name << "\n*ELASTIC\n"
-        << num(materials[k].youngs_modulus) << ", " << num(materials[k].poisson_ratio) << '\n'
+        << format_inp_number(materials[k].youngs_modulus) << ", "
+        << format_inp_number(materials[k].poisson_ratio) << '\n'
         << "*SOLID SECTION, ELSET=" << name << ", MATERIAL=" << name << '\n';
   }
   out << "** fixed supports (zero displacement in the fixed components)\n*BOUNDARY\n";
@@ -143,7 +142,7 @@ void write_inp_deck(const RunResult& r, const std::string& dir) {
   out << "*STEP\n*STATIC\n** muscle loads: consistent nodal forces of the uniform tractions\n*CLOAD\n";
   for (const auto& [node, f] : loads)
     for (int d = 0; d < 3; ++d)
-      if (f[d] != 0.0) out << node + 1 << ", " << d + 1 << ", " << num(f[d]) << '\n';
+      if (f[d] != 0.0) out << node + 1 << ", " << d + 1 << ", " << format_inp_number(f[d]) << '\n';
   out << "*NODE PRINT, NSET=NALL\nU\n";
   for (std::size_t i = 0; i < s.supports.size(); ++i)
     out << "*NODE PRINT, NSET=" << node_sets[i].name << ", TOTALS=ONLY\nRF\n";
@@ -152,12 +151,12 @@ void write_inp_deck(const RunResult& r, const std::string& dir) {
 }
 
 // The solution arrays of a level, on its whole mesh.
-void solution_arrays(const LevelResult& l, std::vector<MeshArray>* cells,
-                     std::vector<MeshArray>* points) {
+void solution_arrays(const LevelResult& l, std::vector<MeshArray>* cells, std::vector<MeshArray>* points) {
   const ElasticitySolution& u = l.solution;
   const std::size_t n = l.mesh.vertices.size(), m = l.mesh.hexes.size();
   MeshArray displacement{"displacement", 3, {}}, vm_point{"von_mises", 1, u.vertex_von_mises};
-  for (const Vec3& d : u.vertex_displacement) displacement.values.insert(displacement.values.end(), d.begin(), d.end());
+  for (const Vec3& d : u.vertex_displacement)
+    displacement.values.insert(displacement.values.end(), d.begin(), d.end());
   // Patch membership: the index of the support (muscle) in the scenario's order, -1 elsewhere; a node on
   // two patches shows the later one.
   MeshArray support_id{"support_id", 1, std::vector<double>(n, -1.0)};
@@ -177,13 +176,14 @@ void solution_arrays(const LevelResult& l, std::vector<MeshArray>* cells,
     E.values.push_back(l.hex_material[h].youngs_modulus);
     nu.values.push_back(l.hex_material[h].poisson_ratio);
   }
-  *cells = {{"von_mises", 1, u.hex_von_mises}, {"von_mises_max", 1, u.hex_von_mises_max}, stress, principal, E, nu};
+  *cells = {
+      {"von_mises", 1, u.hex_von_mises}, {"von_mises_max", 1, u.hex_von_mises_max}, stress, principal, E, nu};
 }
 
 // Piece `rank` of `ranks`: the contiguous block of hexes [m rank / ranks, m (rank + 1) / ranks) on the
 // vertices they use (renumbered in ascending order), with the arrays sliced to match.
-void slice(const HexMesh& mesh, int rank, int ranks, std::vector<MeshArray>* cells, std::vector<MeshArray>* points,
-           HexMesh* piece) {
+void slice(const HexMesh& mesh, int rank, int ranks, std::vector<MeshArray>* cells,
+           std::vector<MeshArray>* points, HexMesh* piece) {
   const std::size_t m = mesh.hexes.size();
   const std::size_t first = m * rank / ranks, last = m * (rank + 1) / ranks;
   std::vector<int> new_id(mesh.vertices.size(), -1);
@@ -204,11 +204,13 @@ void slice(const HexMesh& mesh, int rank, int ranks, std::vector<MeshArray>* cel
     piece->hexes.push_back(hex);
   }
   for (MeshArray& a : *cells)
-    a.values = std::vector<double>(a.values.begin() + first * a.components, a.values.begin() + last * a.components);
+    a.values =
+        std::vector<double>(a.values.begin() + first * a.components, a.values.begin() + last * a.components);
   for (MeshArray& a : *points) {
     std::vector<double> values;
-    for (int v : old_id) values.insert(values.end(), a.values.begin() + v * a.components,
-                                       a.values.begin() + (v + 1) * a.components);
+    for (int v : old_id)
+      values.insert(values.end(), a.values.begin() + v * a.components,
+                    a.values.begin() + (v + 1) * a.components);
     a.values = std::move(values);
   }
 }
@@ -221,14 +223,14 @@ std::string pvtu_text(const std::vector<MeshArray>& cells, const std::vector<Mes
          "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
   out << "    <PPointData>\n";
   for (const MeshArray& a : points)
-    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\"" << a.components
-        << "\"/>\n";
+    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\""
+        << a.components << "\"/>\n";
   out << "    </PPointData>\n    <PCellData>\n";
   for (const char* name : kVtuQualityArrays)
     out << "      <PDataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"1\"/>\n";
   for (const MeshArray& a : cells)
-    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\"" << a.components
-        << "\"/>\n";
+    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\""
+        << a.components << "\"/>\n";
   out << "    </PCellData>\n    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
          "    </PPoints>\n";
   for (const std::string& p : pieces) out << "    <Piece Source=\"" << p << "\"/>\n";
@@ -259,9 +261,15 @@ std::vector<std::string> write_solution(const LevelResult& l, const std::string&
   return pieces;
 }
 
-double bite_force(const ElasticitySolution& u) { return u.bite_force; }
-double max_displacement(const ElasticitySolution& u) { return u.max_displacement; }
-double strain_energy(const ElasticitySolution& u) { return u.strain_energy; }
+double bite_force(const ElasticitySolution& u) {
+  return u.bite_force;
+}
+double max_displacement(const ElasticitySolution& u) {
+  return u.max_displacement;
+}
+double strain_energy(const ElasticitySolution& u) {
+  return u.strain_energy;
+}
 
 }  // namespace
 

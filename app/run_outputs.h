@@ -22,7 +22,8 @@ void check_inp_exportable(const Scenario& scenario);
 nlohmann::json results_json(const RunResult& result, double seconds_output);
 
 // Writes DIR/mesh.vtu and the solution files of every level (unless the scenario's outputs.vtu is false)
-// and, with `export_inp`, DIR/model.inp with DIR/model_mesh.inp. Creates DIR. Returns the names of the files written (relative to DIR).
+// and, with `export_inp`, DIR/model.inp with DIR/model_mesh.inp. Creates DIR. Returns the names of the files
+// written (relative to DIR).
 std::vector<std::string> write_run_outputs(const RunResult& result, const std::string& dir, bool export_inp);
 
 // The table printed at the end of a run: per level bite force, reactions, maximum displacement, von Mises

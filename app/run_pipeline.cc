@@ -73,7 +73,8 @@ long long count_dofs(const HexMesh& mesh, int degree) {
     edges.reserve(12 * mesh.hexes.size());
     faces.reserve(6 * mesh.hexes.size());
     for (const auto& hex : mesh.hexes) {
-      for (const auto& e : kEdges) edges.push_back({std::min(hex[e[0]], hex[e[1]]), std::max(hex[e[0]], hex[e[1]])});
+      for (const auto& e : kEdges)
+        edges.push_back({std::min(hex[e[0]], hex[e[1]]), std::max(hex[e[0]], hex[e[1]])});
       for (const auto& f : kHexFaces) {
         std::array<int, 4> key{hex[f[0]], hex[f[1]], hex[f[2]], hex[f[3]]};
         std::sort(key.begin(), key.end());
@@ -106,14 +107,16 @@ void for_each_gauss_point(const HexMesh& mesh, const BoundaryQuad& quad, F&& f) 
           xu[d] += Nu[a] * mesh.vertices[quad[a]][d];
           xv[d] += Nv[a] * mesh.vertices[quad[a]][d];
         }
-      const Vec3 n{xu[1] * xv[2] - xu[2] * xv[1], xu[2] * xv[0] - xu[0] * xv[2], xu[0] * xv[1] - xu[1] * xv[0]};
+      const Vec3 n{xu[1] * xv[2] - xu[2] * xv[1], xu[2] * xv[0] - xu[0] * xv[2],
+                   xu[0] * xv[1] - xu[1] * xv[0]};
       f(N, 0.25 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]));
     }
 }
 
 // The boundary quads that a scenario patch selects, as mesh vertex ids.
 MeshPatch select_patch(const HexMesh& mesh, const HexBoundary& boundary, const std::string& name,
-                       const Vec3& center, double radius, const SourceLocation& where, const std::string& what) {
+                       const Vec3& center, double radius, const SourceLocation& where,
+                       const std::string& what) {
   MeshPatch patch;
   patch.name = name;
   for (int q : require_patch_quads(boundary.surface, center, radius, where, what)) {

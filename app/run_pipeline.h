@@ -35,8 +35,8 @@ struct LevelResult {
   int level = 0;  // 0 = the coarse mesh, k = refined k times
   HexMesh mesh;
   QualitySummary quality;
-  std::vector<MeshPatch> muscle_patches;  // the muscles with activation > 0, in scenario order
-  std::vector<Vec3> muscle_forces;        // N, total force of each of those muscles
+  std::vector<MeshPatch> muscle_patches;   // the muscles with activation > 0, in scenario order
+  std::vector<Vec3> muscle_forces;         // N, total force of each of those muscles
   std::vector<MeshPatch> support_patches;  // every support, in scenario order
   std::vector<Material> hex_material;      // one per hex
   ElasticitySolution solution;
@@ -45,7 +45,7 @@ struct LevelResult {
 };
 
 struct RunResult {
-  Scenario scenario;  // with every point resolved
+  Scenario scenario;      // with every point resolved
   MeshFidelity fidelity;  // of the coarse mesh against the bone surface
   std::vector<LevelResult> levels;
   double seconds_geometry = 0.0;

@@ -22,6 +22,8 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -319,6 +321,23 @@ void write_set(std::ostringstream& out, const char* keyword, const IndexSet& set
 
 }  // namespace
 
+std::string format_inp_number(double v) {
+  char buf[32];
+  int digits = 17;
+  for (int d = 15; d <= 17; ++d) {
+    std::snprintf(buf, sizeof buf, "%.*g", d, v);
+    if (std::strtod(buf, nullptr) == v) {
+      digits = d;
+      break;
+    }
+  }
+  // CalculiX reads the first 20 characters of a field: give up the last digits rather than the exponent.
+  for (;; --digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strlen(buf) <= 20) return buf;
+  }
+}
+
 void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<IndexSet>& node_sets,
                const std::vector<IndexSet>& element_sets) {
   std::set<std::string> names = {"NALL", "EALL"};
@@ -331,8 +350,8 @@ void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<I
   out << "*NODE, NSET=NALL\n";
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Vec3& p = mesh.vertices[v];
-    out << v + 1 << ", " << format_double(p[0]) << ", " << format_double(p[1]) << ", " << format_double(p[2])
-        << '\n';
+    out << v + 1 << ", " << format_inp_number(p[0]) << ", " << format_inp_number(p[1]) << ", "
+        << format_inp_number(p[2]) << '\n';
   }
   // C3D8 numbers its nodes like VTK_HEXAHEDRON: face 1-2-3-4, then 5-6-7-8 above it.
   out << "*ELEMENT, TYPE=C3D8, ELSET=EALL\n";

@@ -51,6 +51,10 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = 
 void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<IndexSet>& node_sets = {},
                const std::vector<IndexSet>& element_sets = {});
 
+// A number for an .inp data line: the shortest text that reads back exactly (15 to 17 significant digits),
+// shortened to the 20 characters that CalculiX reads of a field (at least 13 significant digits remain).
+std::string format_inp_number(double v);
+
 // Writes a Gmsh 4.1 ASCII .msh file: one volume entity, nodes tagged 1..n, hexahedra (element type 5,
 // Gmsh's node order, which equals VTK's) tagged 1..m.
 void write_msh(const std::string& path, const HexMesh& mesh);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# One command for the main job: installs the packages, builds, and runs the default job on the
-# built-in procedural mandible. Outputs go to out/ (or the folder given as the first argument).
+# One command for the main job: installs the packages, builds, and runs the default job, the seed paper's
+# lateral bite on a hard nut (scenarios/lateral_bite_hard_nut.yaml) on the built-in procedural mandible,
+# printing its summary table. Outputs go to out/ (or the folder given as the first argument).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -11,4 +12,5 @@ hexbite=${HEXBITE_BUILD_DIR:-build}/app/hexbite
 "$hexbite" generate mandible -o "$out/jaw.stl" --landmarks "$out/jaw.landmarks.yaml" --ct "$out/jaw.mha"
 "$hexbite" surface check "$out/jaw.stl"
 "$hexbite" surface clean "$out/jaw.stl" -o "$out/jaw_clean.stl"
+"$hexbite" run scenarios/lateral_bite_hard_nut.yaml -o "$out/lateral_bite_hard_nut"
 echo "main: outputs in $out/"

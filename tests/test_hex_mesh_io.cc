@@ -7,6 +7,7 @@
 #include <vtkXMLUnstructuredGridWriter.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -383,6 +384,22 @@ TEST(QualityCommand, BadInputExitsTwo) {
     EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
+}
+
+}  // namespace
+}  // namespace hexbite
+
+namespace hexbite {
+namespace {
+
+// CalculiX reads 20 characters of a data field; a longer number would lose its exponent.
+TEST(InpNumber, FitsTwentyCharactersAndReadsBackClosely) {
+  for (double v : {-5.1474133753646426e-05, 0.28, -0.024689548693392765, 11000.0, -1.2345678901234567e-100}) {
+    const std::string text = format_inp_number(v);
+    EXPECT_LE(text.size(), 20u) << text;
+    EXPECT_NEAR(std::strtod(text.c_str(), nullptr), v, 5e-13 * std::abs(v)) << text;  // 13 digits at least
+  }
+  EXPECT_EQ(format_inp_number(0.28), "0.28");
 }
 
 }  // namespace
