@@ -1,4 +1,5 @@
-// `hexbite render`: a picture of a surface for reports and the README.
+// `hexbite render`: a picture of a surface or of a mesh coloured by a result field, for reports and the
+// README.
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
@@ -9,24 +10,43 @@
 
 namespace hexbite {
 
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
 void add_render_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("render", "Render a surface to a PNG picture (needs an X display)");
+  auto* cmd =
+      app.add_subcommand("render", "Render a surface or a mesh (VTU) to a PNG picture (needs an X display)");
   struct Args {
-    std::string input, output, units = "mm";
+    std::string input, output, units = "mm", field;
     RenderOptions options;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("INPUT", args->input, "Surface file (STL, OBJ, PLY, OFF, VTP)")->required();
+  cmd->add_option("INPUT", args->input, "Surface file (STL, OBJ, PLY, OFF, VTP) or hex mesh / solution (VTU)")
+      ->required();
   cmd->add_option("-o,--output", args->output, "PNG file to write")->required();
-  cmd->add_option("--units", args->units, "Length unit of the input: mm, cm or m");
+  cmd->add_option("--units", args->units, "Length unit of a surface input: mm, cm or m");
+  cmd->add_option("--field", args->field,
+                  "VTU only: colour by this point array (e.g. von_mises, displacement)");
+  cmd->add_option("--max", args->options.colour_max,
+                  "Upper end of the colour scale (default: the field's maximum)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--view", args->options.view, "iso, side (from the right), front, back or top");
   cmd->add_option("--width", args->options.width, "Picture width in pixels")->check(CLI::Range(64, 8192));
   cmd->add_option("--height", args->options.height, "Picture height in pixels")->check(CLI::Range(64, 8192));
   cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner");
   cmd->add_flag("!--no-edges", args->options.edges, "Do not draw the element edges");
   cmd->callback([args] {
-    const TriSurface surface = read_surface(args->input, unit_to_mm(args->units));
-    render_surface_png(surface, args->output, args->options);
+    if (ends_with(args->input, ".vtu")) {
+      render_mesh_png(args->input, args->field, args->output, args->options);
+    } else {
+      const TriSurface surface = read_surface(args->input, unit_to_mm(args->units));
+      render_surface_png(surface, args->output, args->options);
+    }
     info("wrote " + args->output);
   });
 }

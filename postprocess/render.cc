@@ -3,8 +3,11 @@
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
+#include <vtkDataSetSurfaceFilter.h>
+#include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
@@ -12,11 +15,15 @@
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkUnstructuredGrid.h>
 #include <vtkWindowToImageFilter.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
 #include <cstdlib>
+#include <filesystem>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -72,23 +79,16 @@ void place_camera(vtkCamera* camera, const std::string& view) {
 
 }  // namespace
 
-void render_surface_png(const TriSurface& surface, const std::string& png_path,
-                        const RenderOptions& options) {
+namespace {
+
+// Draws one actor (and optional 2-D actors) with the chosen view and writes the PNG.
+void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& png_path,
+                      const RenderOptions& options) {
   vtkNew<vtkCamera> camera;
   place_camera(camera, options.view);  // validates the view before anything is opened
   if (!can_render())
     throw RunError("cannot render '" + png_path +
                    "': no X display (DISPLAY is not set); run the command under `xvfb-run -a`");
-
-  vtkNew<vtkPolyDataNormals> normals;  // smooth shading without changing the geometry
-  normals->SetInputData(to_polydata(surface));
-  normals->SplittingOff();
-  normals->ConsistencyOff();
-  vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputConnection(normals->GetOutputPort());
-  vtkNew<vtkActor> actor;
-  actor->SetMapper(mapper);
-  actor->GetProperty()->SetColor(0.93, 0.89, 0.80);  // bone
   actor->GetProperty()->SetSpecular(0.2);
   if (options.edges) {
     actor->GetProperty()->EdgeVisibilityOn();
@@ -97,6 +97,7 @@ void render_surface_png(const TriSurface& surface, const std::string& png_path,
 
   vtkNew<vtkRenderer> renderer;
   renderer->AddActor(actor);
+  if (legend != nullptr) renderer->AddActor2D(legend);
   renderer->SetBackground(1, 1, 1);
   renderer->SetActiveCamera(camera);
   renderer->ResetCamera();
@@ -127,6 +128,79 @@ void render_surface_png(const TriSurface& surface, const std::string& png_path,
     writer->Write();
     if (writer->GetErrorCode() != 0) throw RunError("cannot write '" + png_path + "'");
   });
+}
+
+}  // namespace
+
+void render_surface_png(const TriSurface& surface, const std::string& png_path,
+                        const RenderOptions& options) {
+  vtkNew<vtkPolyDataNormals> normals;  // smooth shading without changing the geometry
+  normals->SetInputData(to_polydata(surface));
+  normals->SplittingOff();
+  normals->ConsistencyOff();
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputConnection(normals->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0.93, 0.89, 0.80);  // bone
+  render_actor_png(actor, nullptr, png_path, options);
+}
+
+void render_mesh_png(const std::string& vtu_path, const std::string& field, const std::string& png_path,
+                     const RenderOptions& options) {
+  if (!std::filesystem::is_regular_file(vtu_path))
+    throw InputError("cannot read '" + vtu_path + "': no such file");
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  reader->SetFileName(vtu_path.c_str());
+  reader->Update();
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  if (reader->GetErrorCode() != 0 || grid == nullptr || grid->GetNumberOfCells() == 0)
+    throw InputError("cannot read '" + vtu_path + "' as a VTK unstructured grid (.vtu) with cells");
+
+  vtkNew<vtkDataSetSurfaceFilter> outer;  // only the boundary faces are visible
+  outer->SetInputData(grid);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputConnection(outer->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  vtkNew<vtkScalarBarActor> bar;
+  vtkNew<vtkLookupTable> colours;
+  if (field.empty()) {
+    mapper->ScalarVisibilityOff();
+    actor->GetProperty()->SetColor(0.93, 0.89, 0.80);
+    render_actor_png(actor, nullptr, png_path, options);
+    return;
+  }
+  vtkDataArray* array = grid->GetPointData()->GetArray(field.c_str());
+  if (array == nullptr) {
+    std::string names;
+    for (int i = 0; i < grid->GetPointData()->GetNumberOfArrays(); ++i)
+      names += std::string(names.empty() ? "" : ", ") + grid->GetPointData()->GetArrayName(i);
+    throw InputError("'" + vtu_path + "' has no point array '" + field +
+                     "'; available: " + (names.empty() ? "none" : names));
+  }
+  const int component = array->GetNumberOfComponents() == 1 ? 0 : -1;  // -1: magnitude
+  double range[2];
+  array->GetRange(range, component);
+  // Stress peaks at the edges of fixed patches would wash out the rest of the picture: let the caller
+  // cap the scale (values above it show in the top colour).
+  if (options.colour_max > 0) range[1] = options.colour_max;
+  colours->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
+  colours->SetTableRange(range);
+  colours->Build();
+  mapper->SetLookupTable(colours);
+  mapper->SetScalarModeToUsePointFieldData();
+  mapper->SelectColorArray(field.c_str());
+  if (component < 0) colours->SetVectorModeToMagnitude();
+  mapper->SetScalarRange(range);
+  mapper->ScalarVisibilityOn();
+  bar->SetLookupTable(colours);
+  bar->SetTitle(field.c_str());
+  bar->SetNumberOfLabels(5);
+  bar->SetMaximumWidthInPixels(110);
+  bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
+  bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
+  render_actor_png(actor, bar, png_path, options);
 }
 
 }  // namespace hexbite

@@ -11,8 +11,9 @@ namespace hexbite {
 struct RenderOptions {
   std::string view = "iso";  // iso | side | front | top | back
   int width = 1200, height = 800;
-  bool edges = true;  // draw the triangle or quad edges
-  std::string title;  // optional caption in the picture's corner
+  bool edges = true;      // draw the triangle or quad edges
+  std::string title;      // optional caption in the picture's corner
+  double colour_max = 0;  // upper end of the colour scale; 0 = the field's maximum
 };
 
 // True when VTK can open a window here: an X display is set. Rendering without one aborts inside
@@ -21,5 +22,12 @@ bool can_render();
 
 // Renders the triangle surface and writes a PNG atomically. Throws RunError when no display.
 void render_surface_png(const TriSurface& surface, const std::string& png_path, const RenderOptions& options);
+
+// Renders the outer surface of a hex mesh file (VTU) coloured by a point array (e.g. "von_mises" of a
+// solution.vtu; vector arrays by their magnitude) with a colour bar, and writes a PNG atomically. An empty
+// field draws the mesh in bone colour. Throws InputError naming the file for an unreadable VTU or an
+// unknown array (listing the available ones), RunError when there is no display.
+void render_mesh_png(const std::string& vtu_path, const std::string& field, const std::string& png_path,
+                     const RenderOptions& options);
 
 }  // namespace hexbite
