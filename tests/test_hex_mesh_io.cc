@@ -17,6 +17,7 @@
 
 #include "common/error.h"
 #include "mesher/hex_block.h"
+#include "mesher/grid_mesher.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
@@ -350,7 +351,8 @@ TEST(QualityCommand, JsonMatchesLibrary) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   const QualitySummary s = summarize_quality(read_vtu(path));
-  EXPECT_EQ(j, quality_to_json(s));
+  EXPECT_EQ(j, quality_to_json(s, hex_mesh_volume(read_vtu(path))));
+  EXPECT_TRUE(j["volume_mm3"].is_number());
   EXPECT_EQ(j["hexes"], 36);
   EXPECT_EQ(j["nodes"], 80);
   EXPECT_GE(j["inverted"].get<int>(), 1);
@@ -368,6 +370,20 @@ TEST(QualityCommand, JsonMatchesLibrary) {
        {"scaled Jacobian", "condition number (cube = 3)", "condition number (Verdict, cube = 1)", "Oddy",
         "inverted elements:", "node degree"})
     EXPECT_NE(table.out.find(row), std::string::npos) << row << "\n" << table.out;
+}
+
+TEST(QualityCommand, JsonVolumeOfVtuAndMsh) {
+  // A 2 x 3 x 4 block of unit cubes, sheared (x += 0.5 z): the volume stays 24, the hexes are not boxes.
+  HexMesh mesh = make_block_mesh(2, 3, 4);
+  for (Vec3& p : mesh.vertices) p[0] += 0.5 * p[2];
+  const std::string dir = temp_dir();
+  write_vtu(dir + "/b.vtu", mesh);
+  write_msh(dir + "/b.msh", mesh);
+  for (const char* name : {"/b.vtu", "/b.msh"}) {
+    const test::CommandResult r = run_hexbite({"quality", dir + name, "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NEAR(nlohmann::json::parse(r.out)["volume_mm3"].get<double>(), 24.0, 1e-9) << name;
+  }
 }
 
 TEST(QualityCommand, BadInputExitsTwo) {

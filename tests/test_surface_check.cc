@@ -10,10 +10,13 @@
 #include "common/error.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_io.h"
+#include "tests/test_shapes.h"
 #include "tests/test_util.h"
 
 namespace hexbite {
 namespace {
+
+using test::torus;
 
 using test::shared_data;
 using test::temp_dir;
@@ -42,25 +45,6 @@ TriSurface merged(TriSurface a, const TriSurface& b) {
 
 void flip(TriSurface& s) {
   for (auto& t : s.triangles) std::swap(t[1], t[2]);
-}
-
-// A torus (R = 10, r = 3) as an n x m grid wrapped in both directions: genus 1.
-TriSurface torus(int n, int m) {
-  TriSurface s;
-  const double pi = std::acos(-1.0);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j) {
-      const double u = 2 * pi * i / n, v = 2 * pi * j / m;
-      s.vertices.push_back(
-          {(10 + 3 * std::cos(v)) * std::cos(u), (10 + 3 * std::cos(v)) * std::sin(u), 3 * std::sin(v)});
-    }
-  auto id = [&](int i, int j) { return (i % n) * m + (j % m); };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j) {
-      s.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      s.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return s;
 }
 
 bool any_contains(const std::vector<std::string>& lines, const std::string& fragment) {

@@ -19,10 +19,13 @@
 #include "mesher/surface_check.h"
 #include "mesher/surface_clean.h"
 #include "mesher/surface_io.h"
+#include "tests/test_shapes.h"
 #include "tests/test_util.h"
 
 namespace hexbite {
 namespace {
+
+using test::torus;
 
 using test::run_hexbite;
 using test::shared_data;
@@ -149,24 +152,6 @@ TriSurface uv_sphere(double radius, int rings, int segments) {
       s.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
     }
   for (int j = 0; j < segments; ++j) s.triangles.push_back({south, id(rings - 1, j + 1), id(rings - 1, j)});
-  return s;
-}
-
-// A torus (R = 10, r = 3) as an n x m grid; with n much larger than m its triangles are needles.
-TriSurface torus(int n, int m) {
-  TriSurface s;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j) {
-      const double u = 2 * kPi * i / n, v = 2 * kPi * j / m;
-      s.vertices.push_back(
-          {(10 + 3 * std::cos(v)) * std::cos(u), (10 + 3 * std::cos(v)) * std::sin(u), 3 * std::sin(v)});
-    }
-  auto id = [&](int i, int j) { return (i % n) * m + (j % m); };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j) {
-      s.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      s.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
   return s;
 }
 
