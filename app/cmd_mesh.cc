@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_sheets.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/grid_mesher.h"
@@ -37,6 +38,8 @@ struct MeshOptions {
   bool json = false;
   bool allow_invalid = false;
   double margin = GridMeshOptions{}.margin;
+  std::string quad_surface;            // --method sheets
+  std::string order = "fewest-hexes";  // --method sheets
 };
 
 std::string fmt(const char* format, double v) {
@@ -72,10 +75,14 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
       << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
-      << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core\n\n";
+      << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core"
+      << (r.attempts > 1
+              ? ", grid " + std::to_string(r.attempts) + " of 3 (earlier grids left inverted hexes)"
+              : std::string())
+      << "\n\n";
   out << phase_table(r.optimize) << '\n';
   out << "optimizer: " << r.optimize.untangle_sweeps << " untangling sweeps, " << r.optimize.iterations
-      << " L-BFGS iterations in " << r.optimize.rounds << " rounds; sum of squared condition numbers "
+      << " Newton sweeps in " << r.optimize.rounds << " rounds; sum of squared condition numbers "
       << fmt("%.6g", r.optimize.energy_before) << " -> " << fmt("%.6g", r.optimize.energy_after) << '\n';
   out << "time: core " << fmt("%.2f", r.seconds_core) << " s, pillow " << fmt("%.2f", r.seconds_pillow)
       << " s, optimization " << fmt("%.2f", r.seconds_optimize) << " s, fidelity "
@@ -109,6 +116,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["grid"] = r.grid;
   j["cells_added_for_manifold"] = r.cells_added_for_manifold;
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
+  j["grid_attempts"] = r.attempts;
   nlohmann::json phases = nlohmann::json::array();
   for (const PhaseQuality& p : r.optimize.phases)
     phases.push_back({{"phase", p.phase}, {"seconds", p.seconds}, {"quality", quality_to_json(p.quality)}});
@@ -160,7 +168,8 @@ std::string inverted_list(const HexMesh& mesh, const std::vector<int>& inverted)
 
 void run_mesh(const MeshOptions& o) {
   if (o.method == "sheets")
-    throw InputError("--method sheets (cycle elimination) is not available yet; use --method grid");
+    return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
+  if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
   if (o.target < kMinTarget || o.target > kMaxTarget)
     throw InputError("--target-hexes " + std::to_string(o.target) + " is out of range: give a number from " +
                      std::to_string(kMinTarget) + " to " + std::to_string(kMaxTarget));
@@ -199,17 +208,24 @@ void run_mesh(const MeshOptions& o) {
 void add_mesh_command(CLI::App& app) {
   auto o = std::make_shared<MeshOptions>();
   CLI::App* cmd = app.add_subcommand("mesh", "Mesh a closed triangulated solid with hexahedra");
-  cmd->add_option("surface", o->surface, "Closed surface (.stl .obj .ply .off .vtp)")->required();
-  cmd->add_option("--method", o->method,
-                  "Meshing method: grid (overlay grid + pillow layer); sheets is not available yet")
+  cmd->add_option("surface", o->surface, "Closed surface (.stl .obj .ply .off .vtp); for --method grid");
+  cmd->add_option("--quad-surface", o->quad_surface,
+                  "Quad surface of a ball (.obj .vtp .vtk), for --method sheets");
+  cmd->add_option("--order", o->order, "Elimination order for --method sheets: fewest-hexes or look-ahead")
+      ->capture_default_str();
+  cmd->add_option(
+         "--method", o->method,
+         "Meshing method: grid (overlay grid + pillow layer) or sheets (cycle elimination of --quad-surface)")
       ->check(CLI::IsMember({"grid", "sheets"}));
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")->default_val(2500);
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required();
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
-  cmd->add_option("--margin", o->margin,
-                  "Core cells have their centre at least this many cell sizes inside the surface; the pillow "
-                  "layer fills the rest (smaller keeps thinner parts in the core)")
-      ->check(CLI::Range(0.0, 2.0))
+  cmd->add_option(
+         "--margin", o->margin,
+         "Core cells have their centre at least this many cell sizes inside the surface (negative: "
+         "at most that far outside); the pillow layer fills the rest (smaller keeps thinner parts in "
+         "the core)")
+      ->check(CLI::Range(-0.8, 2.0))
       ->default_val(o->margin);
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");

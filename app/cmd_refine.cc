@@ -84,7 +84,7 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
         << fmt("%.4f", l.max_projection) << " mm), " << l.backed_off_nodes
         << " backed off to avoid inverting a hex, " << l.damaged_hexes << " hexes damaged; "
         << (l.optimized ? "re-optimized " + std::to_string(l.optimized_hexes) + " hexes around them (" +
-                              std::to_string(l.optimize.iterations) + " L-BFGS iterations)"
+                              std::to_string(l.optimize.iterations) + " Newton sweeps)"
                         : std::string("not re-optimized (projection damaged nothing)"))
         << '\n';
     if (l.off_surface_nodes > 0)

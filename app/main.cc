@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   hexbite::add_refine_command(app);
   hexbite::add_reorder_command(app);
   hexbite::add_run_command(app);
+  hexbite::add_quad_commands(app);
 
   try {
     app.parse(argc, argv);

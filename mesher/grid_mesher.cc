@@ -128,13 +128,17 @@ void classify(Selection& s, const SurfaceProjector& surface) {
     }
 }
 
-// Selects the core cells: centres inside, at least margin * h from the surface. Distances are computed only
-// for inside cells within a few cells of an outside cell; deeper cells are far enough by construction.
+// Selects the core cells: the cells whose centre lies at least margin * h inside the surface. A negative
+// margin also takes cells whose centre lies outside but within -margin * h of the surface, that is cells
+// that reach well into the solid: then a plate or a neck thinner than a cell keeps a sheet of cells (which
+// the pillow layer pulls below the surface) instead of vanishing from the core. Distances are computed for
+// the inside cells within a few cells of an outside cell when the margin is positive (deeper cells are far
+// enough by construction), and for every outside cell when it is negative.
 void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
   const Grid& g = s.grid;
   const long nc = g.cells();
   s.score.assign(nc, std::numeric_limits<double>::quiet_NaN());
-  const int reach = int(std::ceil(margin)) + 1;
+  const int reach = int(std::ceil(std::max(margin, 0.0))) + 1;
   std::vector<char> near(nc, 0);
   for (long c = 0; c < nc; ++c) {
     if (s.inside[c]) continue;
@@ -150,8 +154,11 @@ void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
   }
   s.selected.assign(nc, 0);
   for (long c = 0; c < nc; ++c) {
-    if (!s.inside[c]) continue;
-    if (!near[c]) {
+    if (!s.inside[c] && margin >= 0.0) continue;
+    // Every inside cell qualifies for a margin <= 0 (its distance is positive), without a distance query.
+    if (s.inside[c] && margin <= 0.0) {
+      s.selected[c] = 1;
+    } else if (!near[c]) {
       s.score[c] = kInf;
       s.selected[c] = 1;
     } else {
@@ -302,17 +309,22 @@ void count_cells(Selection& s) {
   }
 }
 
+// The selection for cell size h, the grid shifted by `shift` cells along every axis.
 Selection build_selection(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, double h,
-                          double margin) {
+                          double shift, double margin) {
   Selection s;
   s.grid.h = h;
   for (int a = 0; a < 3; ++a) {
-    s.grid.n[a] = int(std::ceil((hi[a] - lo[a]) / h)) + 2;
+    // Two more cells when shifted, so that the outer layer stays outside the bounding box.
+    s.grid.n[a] = int(std::ceil((hi[a] - lo[a]) / h)) + (shift != 0.0 ? 4 : 2);
     // Centre the grid on the bounding box, so that the result does not depend on which corner is lower.
-    s.grid.origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * s.grid.n[a] * h;
+    s.grid.origin[a] = 0.5 * (lo[a] + hi[a]) - (0.5 * s.grid.n[a] - shift) * h;
   }
   classify(s, surface);
   select_core(s, surface, margin);
+  // Manifold repair first: a part that touches the rest only along an edge or at a vertex (a thin process
+  // at this cell size) is then joined by a cell instead of being dropped as a separate component.
+  make_manifold(s, surface);
   keep_largest_component(s);
   fill_cavities(s);
   make_manifold(s, surface);
@@ -550,7 +562,6 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     throw InputError("grid mesher: the target hex count must be at least 8, got " +
                      std::to_string(options.target_hexes));
   const auto t_start = std::chrono::steady_clock::now();
-  GridMeshReport report;
   const SurfaceProjector projector(surface);
   const double volume = enclosed_volume(surface);
   if (!(volume > 0))
@@ -559,59 +570,81 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   for (const Vec3& p : surface.vertices)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
 
-  // The cell size: secant steps on log(total hexes) against log(h), where total = core cells + core
-  // boundary quads (one pillow hex each). The count falls like h^-2 to h^-3; start from the slope -2.5.
-  const double target = double(options.target_hexes);
-  Progress progress("grid core");
-  double h = std::cbrt(volume / target);
-  Selection best;
-  double best_error = kInf;
-  double prev_h = 0, prev_total = 0;
-  for (int step = 0; step < 8; ++step) {
-    Selection s = build_selection(projector, lo, hi, h, options.margin);
-    const double total = double(s.core_cells + s.boundary_quads);
-    const double error = std::fabs(total - target) / target;
-    if (s.core_cells > 0 && error < best_error) best_error = error, best = std::move(s);
-    progress.update(double(step + 1) / 8,
-                    "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
-    if (best_error < 0.02) break;
-    double slope = -2.5;
-    if (prev_total > 0 && total > 0 && prev_h != h) {
-      const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
-      if (fitted < -1.0 && fitted > -4.0) slope = fitted;
+  // Where a thin part cuts through a cell decides how its hexes look, so a grid can leave a tangle that the
+  // untangler cannot undo. Then the grid is shifted by half a cell, and by a quarter, and the first valid
+  // mesh is kept (or the one with the fewest inverted hexes, then the best minimum scaled Jacobian).
+  const double shifts[] = {0.0, 0.5, 0.25};
+  GridMeshReport report;
+  HexMesh mesh;
+  Selection kept;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const auto t_attempt = std::chrono::steady_clock::now();
+    GridMeshReport r;
+    // The cell size: secant steps on log(total hexes) against log(h), where total = core cells + core
+    // boundary quads (one pillow hex each). The count falls like h^-2 to h^-3; start from the slope -2.5.
+    const double target = double(options.target_hexes);
+    Progress progress("grid core");
+    double h = std::cbrt(volume / target);
+    Selection best;
+    double best_error = kInf;
+    double prev_h = 0, prev_total = 0;
+    for (int step = 0; step < 8; ++step) {
+      Selection s = build_selection(projector, lo, hi, h, shifts[attempt], options.margin);
+      const double total = double(s.core_cells + s.boundary_quads);
+      const double error = std::fabs(total - target) / target;
+      if (s.core_cells > 0 && error < best_error) best_error = error, best = std::move(s);
+      progress.update(double(step + 1) / 8,
+                      "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
+      if (best_error < 0.02) break;
+      double slope = -2.5;
+      if (prev_total > 0 && total > 0 && prev_h != h) {
+        const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
+        if (fitted < -1.0 && fitted > -4.0) slope = fitted;
+      }
+      prev_h = h;
+      prev_total = total;
+      h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
     }
-    prev_h = h;
-    prev_total = total;
-    h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
+    progress.finish();
+    if (best.core_cells == 0)
+      throw InputError("grid mesher: no grid cell fits inside the surface; the solid is too thin for " +
+                       std::to_string(options.target_hexes) + " hexes, ask for more");
+    r.cell_size = best.grid.h;
+    r.grid = best.grid.n;
+    r.cells_added_for_manifold = best.added_for_manifold;
+    r.cells_in_dropped_components = best.dropped;
+    HexMesh m = core_mesh(best);
+    r.core_hexes = int(m.hexes.size());
+    r.seconds_core = seconds_since(t_attempt);
+
+    auto t0 = std::chrono::steady_clock::now();
+    r.pillow_hexes = add_pillow_layer(m, projector, best.grid.h);
+    r.seconds_pillow = seconds_since(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    r.optimize = optimize_hex_mesh(m, &projector, {}, options.optimize);
+    r.seconds_optimize = seconds_since(t0);
+
+    const QualitySummary& q = r.optimize.phases.back().quality;
+    const QualitySummary* kept_q = attempt > 0 ? &report.optimize.phases.back().quality : nullptr;
+    if (!kept_q || q.inverted < kept_q->inverted ||
+        (q.inverted == kept_q->inverted && q.scaled_jacobian.min > kept_q->scaled_jacobian.min)) {
+      report = std::move(r);
+      mesh = std::move(m);
+      kept = std::move(best);
+    }
+    report.attempts = attempt + 1;
+    if (report.optimize.inverted == 0) break;
   }
-  progress.finish();
-  if (best.core_cells == 0)
-    throw InputError("grid mesher: no grid cell fits inside the surface; the solid is too thin for " +
-                     std::to_string(options.target_hexes) + " hexes, ask for more");
-  report.cell_size = best.grid.h;
-  report.grid = best.grid.n;
-  report.cells_added_for_manifold = best.added_for_manifold;
-  report.cells_in_dropped_components = best.dropped;
-  HexMesh mesh = core_mesh(best);
-  report.core_hexes = int(mesh.hexes.size());
-  report.seconds_core = seconds_since(t_start);
 
-  auto t0 = std::chrono::steady_clock::now();
-  report.pillow_hexes = add_pillow_layer(mesh, projector, best.grid.h);
-  report.seconds_pillow = seconds_since(t0);
-
-  t0 = std::chrono::steady_clock::now();
-  report.optimize = optimize_hex_mesh(mesh, &projector, {}, options.optimize);
-  report.seconds_optimize = seconds_since(t0);
-
-  t0 = std::chrono::steady_clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   report.fidelity = measure_fidelity(mesh, projector);
-  if (best.dropped > 0) {
+  if (kept.dropped > 0) {
     UnresolvedPart part;
-    part.location = best.dropped_centroid;
-    part.samples = best.dropped;
+    part.location = kept.dropped_centroid;
+    part.samples = kept.dropped;
     part.what =
-        std::to_string(best.dropped) + " grid cells around " + format_point(best.dropped_centroid) +
+        std::to_string(kept.dropped) + " grid cells around " + format_point(kept.dropped_centroid) +
         " were not face-connected to the main core and were dropped (a narrow neck at this cell size)";
     report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
   }

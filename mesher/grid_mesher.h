@@ -8,14 +8,22 @@
 // Algorithm:
 //   1. cell size h from the target, counting the pillow layer (core cells + core boundary quads), found by
 //      a few secant steps on the actual counts;
-//   2. core: the grid cells whose centre lies inside the surface at a distance of at least margin * h
-//      (inside by crossing parity along grid columns, distances from the AABB tree); the largest
-//      face-connected component is kept, enclosed cavities are filled, and cells are added until no two
-//      cells share only an edge or a vertex and the core boundary is a 2-manifold;
-//   3. pillow layer: each core boundary vertex gets a copy on the surface (along the vertex normal, or the
-//      closest point), and each core boundary quad one hex to it, so no hex has two boundary faces;
-//   4. optimize_hex_mesh with the boundary sliding on the surface.
-// Cost: O(N) cells and O(N^(2/3)) surface queries for classification; the optimizer dominates.
+//   2. core: the grid cells whose centre lies inside the surface at a distance of at least margin * h, or
+//      with the default negative margin outside at most -margin * h (cells that reach well into the solid,
+//      so that plates thinner than a cell, like the coronoid process, keep a sheet of cells); inside by
+//      crossing parity along grid columns, distances from the AABB tree. Cells are added until no two cells
+//      share only an edge or a vertex and the core boundary is a 2-manifold (this also joins parts that
+//      touch the rest only along an edge), the largest face-connected component is kept and enclosed
+//      cavities are filled;
+//   3. pillow layer: core boundary vertices outside or near the surface are pulled below it, then each gets
+//      a copy on the surface (along the vertex normal, or the closest point), and each core boundary quad one
+//      hex to it, so no hex has two boundary faces;
+//   4. optimize_hex_mesh with the boundary sliding on the surface;
+//   5. when hexes stay inverted, steps 1-4 again on the grid shifted by half a cell, then by a quarter; the
+//      first valid mesh is kept (or the one with the fewest inverted hexes).
+// Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
+// (for the default negative margin) per trial size; the optimizer dominates. A shifted grid (step 5)
+// repeats everything.
 // Deterministic: same surface and options, same mesh (bit for bit).
 #pragma once
 
@@ -32,7 +40,10 @@ class SurfaceProjector;
 
 struct GridMeshOptions {
   long target_hexes = 2500;
-  double margin = 0.25;  // cell centres at least margin * h inside the surface form the core
+  // Cells whose centre lies at least margin * h inside the surface form the core; a negative margin takes
+  // cells whose centre lies up to -margin * h outside (cells reaching into the solid), so that parts
+  // thinner than a cell stay in the core.
+  double margin = -0.4;
   OptimizeOptions optimize;
 };
 
@@ -57,7 +68,8 @@ struct MeshFidelity {
 };
 
 struct GridMeshReport {
-  double cell_size = 0;       // h, mm
+  int attempts = 1;           // grids tried (shifted when a grid left inverted hexes), the last one kept
+  double cell_size = 0;       // h, mm (this and the fields below describe the kept grid)
   std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;
   int pillow_hexes = 0;
@@ -65,6 +77,7 @@ struct GridMeshReport {
   int cells_in_dropped_components = 0;
   OptimizeReport optimize;
   MeshFidelity fidelity;
+  // The kept grid's phases; seconds_total covers every grid tried.
   double seconds_core = 0, seconds_pillow = 0, seconds_optimize = 0, seconds_fidelity = 0, seconds_total = 0;
 };
 

@@ -215,8 +215,9 @@ double min_corner_det(const HexMesh& mesh, const std::vector<CornerRef>& corners
 // One untangling visit of node v: damped Newton ascent on the soft minimum
 //   S(p) = -(1/mu) log sum_i exp(-mu det_i(p) / h^3)
 // of the corner Jacobians that depend on p (each is affine in p, so S is concave). A step is accepted only
-// when the true minimum of those Jacobians grows. Returns true when the node moved.
-bool untangle_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sliding,
+// when the true minimum of those Jacobians grows. A boundary node released from the surface (`max_off` > 0)
+// moves freely but no farther than max_off from the surface. Returns true when the node moved.
+bool untangle_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sliding, double max_off,
                    const SurfaceProjector* surface, std::vector<CornerRef>& corners) {
   corners_of_node(mesh, adj, v, corners);
   if (corners.empty()) return false;
@@ -271,7 +272,8 @@ bool untangle_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sl
       Vec3 trial = {old[0] + dp[0], old[1] + dp[1], old[2] + dp[2]};
       if (sliding) trial = surface->closest(trial).point;
       mesh.vertices[v] = trial;
-      if (min_corner_det(mesh, corners) > old_min + 1e-12 * s) {
+      if (min_corner_det(mesh, corners) > old_min + 1e-12 * s &&
+          (max_off <= 0.0 || surface->distance(trial) <= max_off)) {
         accepted = true;
       } else {
         dp *= 0.5;
@@ -346,6 +348,7 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
   if (inverted == 0) return 0;
   Progress progress("untangling");
   int sweeps = 0, stalled = 0, ring = 0, best = inverted;
+  bool release = false;
   while (inverted > 0 && sweeps < max_sweeps) {
     // The nodes to visit: those of the inverted hexes, widened by one ring of hexes after sweeps that did
     // not reduce the count (the tangle then needs room from its neighbours).
@@ -353,6 +356,7 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
     for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
       if (inv[e])
         for (int v : mesh.hexes[e]) visit[v] = 1;
+    const std::vector<char> own = visit;
     for (int r = 0; r < ring; ++r) {
       std::vector<char> wider = visit;
       for (std::size_t v = 0; v < visit.size(); ++v)
@@ -361,16 +365,24 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
             for (int w : mesh.hexes[adj.hex_list[i]]) wider[w] = 1;
       visit.swap(wider);
     }
-    for (std::size_t v = 0; v < visit.size(); ++v)
-      if (visit[v] && movable[v])
-        untangle_node(mesh, adj, static_cast<int>(v), h[v], sliding.empty() ? false : sliding[v] != 0,
-                      surface, corners);
+    for (std::size_t v = 0; v < visit.size(); ++v) {
+      if (!visit[v] || !movable[v]) continue;
+      const bool slides = !sliding.empty() && sliding[v] != 0;
+      const bool released = slides && release && own[v];
+      untangle_node(mesh, adj, static_cast<int>(v), h[v], slides && !released, released ? 0.25 * h[v] : 0.0,
+                    surface, corners);
+    }
     ++sweeps;
     inv = inverted_mask(mesh, &inverted);
     if (inverted < best) {
       best = inverted;
       stalled = 0;
     } else if (++stalled >= 2) {
+      // Widen the region; when the widest region is stuck too, the surface itself is in the way (two
+      // boundary nodes from opposite sides of a thin part on nearly the same surface point): then the
+      // sliding nodes of the inverted hexes may leave the surface by up to a quarter edge, which costs a
+      // little fidelity instead of an inverted hex.
+      if (ring == 3) release = true;
       ring = std::min(ring + 1, 3);
       stalled = 0;
     }
@@ -387,211 +399,152 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
   const std::size_t nv = mesh.vertices.size();
   const Adjacency adj(mesh);
   const std::vector<double> h = local_edge_length(mesh, adj);
+  if (rounds_out) *rounds_out = 1;
 
   // Inverted hexes stay out of the objective and their nodes stay put, so that the energy is finite.
   int inverted = 0;
   const std::vector<char> inv = inverted_mask(mesh, &inverted);
-  std::vector<char> active(mesh.hexes.size(), 1);
   std::vector<char> movable = movable_in;
   for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-    if (inv[e]) {
-      active[e] = 0;
+    if (inv[e])
       for (int v : mesh.hexes[e]) movable[v] = 0;
-    }
   std::vector<char> sliding(nv, 0);
   for (std::size_t v = 0; v < nv; ++v)
     sliding[v] = movable[v] && surface != nullptr && !sliding_in.empty() && sliding_in[v];
 
-  // Variables: three per free interior node, two (tangent-plane coordinates) per sliding node.
-  std::vector<int> offset(nv, -1);
-  int nvar = 0;
-  for (std::size_t v = 0; v < nv; ++v)
-    if (movable[v]) {
-      offset[v] = nvar;
-      nvar += sliding[v] ? 2 : 3;
-    }
-  if (rounds_out) *rounds_out = 0;
-  if (nvar == 0) return 0;
+  // The corners whose condition number depends on each movable node (corners of inverted hexes left out).
+  std::vector<std::vector<CornerRef>> corners(nv);
+  std::vector<CornerRef> all;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!movable[v]) continue;
+    corners_of_node(mesh, adj, static_cast<int>(v), all);
+    for (const CornerRef& c : all)
+      if (!inv[c.hex]) corners[v].push_back(c);
+  }
+  std::vector<char> valid(mesh.hexes.size());
+  for (std::size_t e = 0; e < valid.size(); ++e) valid[e] = !inv[e];
+  double energy = active_energy(mesh, valid, nullptr);
 
-  std::vector<Vec3> t1(nv), t2(nv);
-  std::vector<Vec3> base = mesh.vertices;
-  std::vector<Vec3> node_grad;
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(nvar), g(nvar);
-
-  auto place = [&](const Eigen::VectorXd& zz) {
-    for (std::size_t v = 0; v < nv; ++v) {
-      const int o = offset[v];
-      if (o < 0) continue;
-      if (sliding[v]) {
-        mesh.vertices[v] = add(base[v], add(scale(t1[v], zz[o]), scale(t2[v], zz[o + 1])));
-      } else {
-        mesh.vertices[v] = {base[v][0] + zz[o], base[v][1] + zz[o + 1], base[v][2] + zz[o + 2]};
-      }
+  // Sliding nodes are tethered to where they entered: a term ((|x - anchor| / r)^2)^2 with r a fraction of
+  // the local edge length. Without it, nodes at a thin tip (the coronoid process) slide away from the tip,
+  // because a blunter boundary has better shaped hexes, and the mesh silently loses the tip.
+  const std::vector<Vec3> anchor = mesh.vertices;
+  // The local objective of node v at position p: the squared condition numbers of its corners plus the
+  // tether, with the gradient with respect to p; +infinity when a corner is not positively oriented.
+  auto local = [&](int v, const Vec3& p, Vec3* grad) {
+    mesh.vertices[v] = p;
+    double f = 0.0;
+    Vec3 g{0, 0, 0};
+    for (const CornerRef& c : corners[v]) {
+      const auto& hx = mesh.hexes[c.hex];
+      const int* nb = kHexCornerNeighbours[c.corner];
+      const Vec3& x = mesh.vertices[hx[c.corner]];
+      const Vec3 a = sub(mesh.vertices[hx[nb[0]]], x), b = sub(mesh.vertices[hx[nb[1]]], x),
+                 cc = sub(mesh.vertices[hx[nb[2]]], x);
+      double fc;
+      Vec3 ga, gb, gc;
+      if (!corner_energy(a, b, cc, fc, ga, gb, gc)) return kInf;
+      f += fc;
+      if (hx[c.corner] == v)
+        g = sub(g, add(add(ga, gb), gc));
+      else if (hx[nb[0]] == v)
+        g = add(g, ga);
+      else if (hx[nb[1]] == v)
+        g = add(g, gb);
+      else
+        g = add(g, gc);
     }
-  };
-  auto evaluate = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gz) {
-    place(zz);
-    const double f = active_energy(mesh, active, gz ? &node_grad : nullptr);
-    if (gz && f < kInf) {
-      for (std::size_t v = 0; v < nv; ++v) {
-        const int o = offset[v];
-        if (o < 0) continue;
-        if (sliding[v]) {
-          (*gz)[o] = dot(node_grad[v], t1[v]);
-          (*gz)[o + 1] = dot(node_grad[v], t2[v]);
-        } else {
-          for (int i = 0; i < 3; ++i) (*gz)[o + i] = node_grad[v][i];
-        }
-      }
+    if (sliding[v] && options.boundary_tether > 0.0) {
+      const double r = options.boundary_tether * h[v];
+      const Vec3 d = sub(p, anchor[v]);
+      const double q = dot(d, d) / (r * r);
+      f += q * q;
+      g = add(g, scale(d, 4.0 * q / (r * r)));
     }
+    if (grad) *grad = g;
     return f;
   };
-  // Largest node displacement for the variable step dz, relative to the node's edge length.
-  auto relative_move = [&](const Eigen::VectorXd& dz) {
-    double m = 0.0;
-    for (std::size_t v = 0; v < nv; ++v) {
-      const int o = offset[v];
-      if (o < 0) continue;
-      const double len = sliding[v]
-                             ? std::hypot(dz[o], dz[o + 1])
-                             : std::sqrt(dz[o] * dz[o] + dz[o + 1] * dz[o + 1] + dz[o + 2] * dz[o + 2]);
-      m = std::max(m, len / h[v]);
+
+  // One Newton step on node v: the Hessian of the local objective by finite differences of its analytic
+  // gradient (in the tangent plane for sliding nodes), eigenvalues floored so that the step descends,
+  // the step capped at half an edge, then backtracking until the objective decreases. Sliding nodes are
+  // projected back onto the surface at every trial, so the objective is measured where the node ends.
+  // Returns the node's movement relative to its edge length; `decrease` receives the objective's decrease.
+  auto relax = [&](int v, double& decrease) {
+    const Vec3 p0 = mesh.vertices[v];
+    Vec3 g0;
+    const double f0 = local(v, p0, &g0);
+    if (!(f0 < kInf)) {
+      mesh.vertices[v] = p0;
+      return 0.0;
     }
-    return m;
+    Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, sliding[v] ? 2 : 3);
+    if (sliding[v]) {
+      Vec3 t1, t2;
+      tangent_frame(surface->closest(p0).normal, t1, t2);
+      basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
+      basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
+    } else {
+      basis.setIdentity();
+    }
+    const int dims = static_cast<int>(basis.cols());
+    const Eigen::Vector3d g3(g0[0], g0[1], g0[2]);
+    const Eigen::VectorXd gr = basis.transpose() * g3;
+    if (!(gr.norm() > 0.0)) return 0.0;
+    const double eps = 1e-5 * h[v];
+    Eigen::MatrixXd hess(dims, dims);
+    bool finite = true;
+    for (int k = 0; k < dims; ++k) {
+      const Eigen::Vector3d dp = eps * basis.col(k);
+      Vec3 gk;
+      finite = finite && local(v, {p0[0] + dp[0], p0[1] + dp[1], p0[2] + dp[2]}, &gk) < kInf;
+      hess.col(k) = basis.transpose() * (Eigen::Vector3d(gk[0], gk[1], gk[2]) - g3) / eps;
+    }
+    Eigen::VectorXd step;
+    if (finite) {
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (hess + hess.transpose()));
+      const double top = es.eigenvalues().cwiseAbs().maxCoeff();
+      Eigen::VectorXd inv_l(dims);
+      for (int k = 0; k < dims; ++k) inv_l[k] = 1.0 / std::max(es.eigenvalues()[k], 1e-3 * top + 1e-300);
+      step = -(es.eigenvectors() * inv_l.asDiagonal() * es.eigenvectors().transpose()) * gr;
+    } else {
+      step = -gr * (0.1 * h[v] / gr.norm());
+    }
+    double t = std::min(1.0, 0.5 * h[v] / std::max(step.norm(), 1e-300));
+    for (int bt = 0; bt < 12; ++bt, t *= 0.5) {
+      const Eigen::Vector3d dp = t * (basis * step);
+      Vec3 trial{p0[0] + dp[0], p0[1] + dp[1], p0[2] + dp[2]};
+      if (sliding[v]) trial = surface->closest(trial).point;
+      const double f = local(v, trial, nullptr);
+      if (f < f0) {
+        decrease = f0 - f;
+        return norm(sub(trial, p0)) / h[v];
+      }
+    }
+    mesh.vertices[v] = p0;
+    return 0.0;
   };
 
-  const bool any_sliding = std::any_of(sliding.begin(), sliding.end(), [](char c) { return c != 0; });
-  const int per_round = any_sliding ? options.iterations_per_round : options.max_iterations;
   Progress progress("condition number optimization");
-  int iterations = 0, rounds = 0;
-  bool done = false;
-  while (!done && iterations < options.max_iterations) {
-    // A new round: the current positions become the base, sliding nodes get a fresh tangent frame.
-    base = mesh.vertices;
-    for (std::size_t v = 0; v < nv; ++v)
-      if (sliding[v]) tangent_frame(surface->closest(base[v]).normal, t1[v], t2[v]);
-    z.setZero();
-    double f = evaluate(z, &g);
-    if (!(f < kInf)) break;  // cannot happen: the round starts from a valid state
-    std::vector<Eigen::VectorXd> s_hist, y_hist;
-    std::vector<double> rho_hist;
-    int round_iterations = 0;
-    bool converged = false;
-    while (round_iterations < per_round && iterations < options.max_iterations) {
-      // L-BFGS two-loop recursion.
-      Eigen::VectorXd q = g;
-      const int m = static_cast<int>(s_hist.size());
-      std::vector<double> alpha(m);
-      for (int i = m - 1; i >= 0; --i) {
-        alpha[i] = rho_hist[i] * s_hist[i].dot(q);
-        q -= alpha[i] * y_hist[i];
-      }
-      if (m > 0) q *= s_hist[m - 1].dot(y_hist[m - 1]) / y_hist[m - 1].dot(y_hist[m - 1]);
-      for (int i = 0; i < m; ++i) {
-        const double beta = rho_hist[i] * y_hist[i].dot(q);
-        q += (alpha[i] - beta) * s_hist[i];
-      }
-      Eigen::VectorXd d = -q;
-      double gd = g.dot(d);
-      if (!(gd < 0.0)) {
-        d = -g;
-        gd = g.dot(d);
-        s_hist.clear(), y_hist.clear(), rho_hist.clear();
-      }
-      // The first step and every steepest-descent step are scaled to move nodes at most a tenth of their
-      // edge length; quasi-Newton steps start at 1 but are capped at half an edge length.
-      const double rel = relative_move(d);
-      double t = (s_hist.empty() ? 0.1 : 0.5) / std::max(rel, 1e-300);
-      if (!s_hist.empty()) t = std::min(1.0, t);
-      Eigen::VectorXd z_new, g_new(nvar);
-      double f_new = kInf;
-      bool accepted = false;
-      for (int bt = 0; bt < 40; ++bt) {
-        z_new = z + t * d;
-        f_new = evaluate(z_new, &g_new);
-        if (f_new < kInf && f_new <= f + 1e-4 * t * gd) {
-          accepted = true;
-          break;
-        }
-        t *= 0.5;
-      }
-      ++iterations;
-      ++round_iterations;
-      if (!accepted) {
-        // Back to the last valid state; without curvature information there is nothing left to try.
-        place(z);
-        if (s_hist.empty()) {
-          converged = true;
-          break;
-        }
-        s_hist.clear(), y_hist.clear(), rho_hist.clear();
-        continue;
-      }
-      const Eigen::VectorXd s = z_new - z;
-      const Eigen::VectorXd y = g_new - g;
-      const double move = relative_move(s);
-      const double sy = s.dot(y);
-      if (sy > 1e-12 * std::sqrt(s.squaredNorm() * y.squaredNorm())) {
-        s_hist.push_back(s);
-        y_hist.push_back(y);
-        rho_hist.push_back(1.0 / sy);
-        if (static_cast<int>(s_hist.size()) > options.lbfgs_memory) {
-          s_hist.erase(s_hist.begin());
-          y_hist.erase(y_hist.begin());
-          rho_hist.erase(rho_hist.begin());
-        }
-      }
-      z = z_new;
-      g = g_new;
-      const double decrease = f - f_new;
-      f = f_new;
-      progress.update(double(iterations) / options.max_iterations,
-                      "iteration " + std::to_string(iterations) + ", move " + std::to_string(move));
-      if (move < options.tolerance || decrease <= 1e-14 * f) {
-        converged = true;
-        break;
-      }
+  int sweeps = 0;
+  while (sweeps < options.max_iterations) {
+    double max_move = 0.0, decrease = 0.0;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (!movable[v] || corners[v].empty()) continue;
+      double d = 0.0;
+      max_move = std::max(max_move, relax(static_cast<int>(v), d));
+      decrease += d;
     }
-    place(z);
-    ++rounds;
-    double projection_move = 0.0;
-    if (any_sliding) {
-      // Project the sliding nodes back onto the surface. Where that inverts a hex, its nodes return to the
-      // round's start (which was valid); repeated until every hex around a returned node is valid again.
-      const std::vector<Vec3> before = mesh.vertices;
-      for (std::size_t v = 0; v < nv; ++v)
-        if (sliding[v]) mesh.vertices[v] = surface->closest(mesh.vertices[v]).point;
-      std::vector<int> check;
-      for (std::size_t e = 0; e < mesh.hexes.size(); ++e) check.push_back(static_cast<int>(e));
-      while (!check.empty()) {
-        std::vector<int> next;
-        std::vector<char> reverted(nv, 0);
-        for (int e : check) {
-          if (!active[e] || hex_min_jacobian(mesh.vertices, mesh.hexes[e]) > 0.0) continue;
-          for (int v : mesh.hexes[e])
-            if (mesh.vertices[v] != base[v]) {
-              mesh.vertices[v] = base[v];
-              reverted[v] = 1;
-            }
-        }
-        for (std::size_t v = 0; v < nv; ++v)
-          if (reverted[v])
-            for (int i = adj.hex_start[v]; i < adj.hex_start[v + 1]; ++i) next.push_back(adj.hex_list[i]);
-        std::sort(next.begin(), next.end());
-        next.erase(std::unique(next.begin(), next.end()), next.end());
-        check.swap(next);
-      }
-      for (std::size_t v = 0; v < nv; ++v)
-        if (sliding[v])
-          projection_move = std::max(projection_move, norm(sub(mesh.vertices[v], before[v])) / h[v]);
-    }
-    if (converged && (round_iterations <= 1 || !any_sliding) && projection_move < 10 * options.tolerance)
-      done = true;
-    if (!any_sliding) done = true;
+    ++sweeps;
+    progress.update(double(sweeps) / options.max_iterations,
+                    "sweep " + std::to_string(sweeps) + ", move " + std::to_string(max_move));
+    // The sum of the local decreases is the decrease of the total energy over the sweep (each step changes
+    // only the node's own terms), so the energy is tracked without re-evaluating it.
+    energy -= decrease;
+    if (max_move < options.tolerance || decrease < 1e-5 * energy) break;
   }
-  progress.finish(std::to_string(iterations) + " iterations, " + std::to_string(rounds) + " rounds");
-  if (rounds_out) *rounds_out = rounds;
-  return iterations;
+  progress.finish(std::to_string(sweeps) + " sweeps");
+  return sweeps;
 }
 
 OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface,

@@ -9,16 +9,20 @@
 //   1. barycentric (Laplacian) smoothing of the interior nodes; interior nodes that left the domain are put
 //      back inside;
 //   2. untangling: node by node, a damped Newton ascent on a soft minimum of the corner Jacobians around the
-//      node, accepted only where the true minimum corner Jacobian grows;
-//   3. optimization of E = sum over all hex corners of kappa(A)^2 (kappa = |A|_F |A^-1|_F) with L-BFGS and
-//      an Armijo backtracking line search. E is +infinity on any non-positive corner Jacobian, so every
-//      accepted step keeps every corner of every hex valid (the validity test covers all hexes around every
-//      moved node). Boundary nodes move in their tangent plane and are projected back onto the surface after
-//      each round; hexes made invalid by the projection are returned to the last valid state. Untangling
-//      and optimization repeat while hexes stay inverted. Optimization stops when the largest node movement
-//      of an iteration, relative to the node's mean incident edge length, falls below the tolerance.
-// Cost: one objective evaluation is O(m) for m hexes (8 corners each); the optimizer runs a few hundred
-// evaluations; each boundary projection is O(b log t) for b boundary nodes and t surface triangles.
+//      node, accepted only where the true minimum corner Jacobian grows; when a tangle resists every widening
+//      of the region, the sliding nodes of its inverted hexes may leave the surface by up to a quarter edge;
+//   3. optimization of E = sum over all hex corners of kappa(A)^2 (kappa = |A|_F |A^-1|_F) by sweeps of
+//      per-node Newton steps: for each movable node in turn, the Hessian of its local terms (by finite
+//      differences of the analytic gradient), a step capped at half an edge and backtracking until the local
+//      objective decreases. The local objective is +infinity on any non-positive corner Jacobian of the
+//      node's hexes, so every accepted step keeps every hex valid. Boundary nodes step in their tangent
+//      plane and are projected back onto the surface at every trial, tethered to where they started so that
+//      they do not abandon thin tips. Untangling and optimization repeat while hexes stay inverted.
+//      Optimization stops when the largest node movement of a sweep, relative to the node's mean incident
+//      edge length, falls below the tolerance, or when a sweep lowers E by less than 1e-5 of it.
+// Cost: one sweep is O(m) for m hexes (each corner is evaluated a few times per node that it depends on);
+// the jaw at 2,500 hexes converges in about 70 sweeps; each boundary trial costs one closest-point query,
+// O(log t) for t surface triangles.
 // Deterministic: single-threaded, fixed node and hex orders, no hashing.
 #pragma once
 
@@ -35,12 +39,13 @@ class SurfaceProjector;
 struct OptimizeOptions {
   int barycentric_iterations = 10;  // Jacobi sweeps of Laplacian smoothing (0 skips the phase)
   int max_untangle_sweeps = 60;     // sweeps over the nodes of inverted hexes, per untangling phase
-  int max_iterations = 1500;        // L-BFGS iterations over all rounds and repeats
-  int iterations_per_round = 40;    // iterations between two projections of the sliding boundary nodes
-  int lbfgs_memory = 8;             // correction pairs kept by L-BFGS
+  int max_iterations = 200;         // sweeps of per-node Newton steps, over all repeats
   double tolerance = 1e-3;          // stop when max |node move| / local edge length < tolerance
   bool slide_boundary = true;       // boundary nodes slide on the surface (needs a projector)
-  int max_repeats = 5;              // untangle + optimize cycles while hexes stay inverted
+  // Sliding nodes pay ((|x - x0| / r)^2)^2 for leaving their entry position x0, with r this fraction of the
+  // local edge length, so that they cannot abandon thin tips and ridges of the surface (0 = no tether).
+  double boundary_tether = 0.5;
+  int max_repeats = 5;  // untangle + optimize cycles while hexes stay inverted
 };
 
 // One row of the per-phase table.
@@ -53,8 +58,8 @@ struct PhaseQuality {
 struct OptimizeReport {
   std::vector<PhaseQuality> phases;  // "barycentric", "untangled", "final" (the middle one only if needed)
   int untangle_sweeps = 0;           // over all untangling phases
-  int iterations = 0;                // L-BFGS iterations
-  int rounds = 0;                    // boundary projection rounds
+  int iterations = 0;                // optimization sweeps (per-node Newton steps over all movable nodes)
+  int rounds = 0;                    // untangle + optimize cycles
   double energy_before = 0.0;        // sum of squared corner condition numbers, valid hexes only
   double energy_after = 0.0;
   int inverted = 0;  // inverted hexes at the end
@@ -77,8 +82,8 @@ int move_inside(HexMesh& mesh, const SurfaceProjector& surface, const std::vecto
 // Returns the number of sweeps used; the mesh is untangled when no hex is inverted afterwards.
 int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
              const SurfaceProjector* surface, int max_sweeps);
-// Returns the number of L-BFGS iterations. Hexes that are inverted on entry are left out of the objective,
-// and their nodes do not move.
+// Returns the number of sweeps. Hexes that are inverted on entry are left out of the objective, and their
+// nodes do not move. `rounds` (when not null) is set to 1.
 int optimize_condition(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
                        const SurfaceProjector* surface, const OptimizeOptions& options,
                        int* rounds = nullptr);

@@ -49,4 +49,10 @@ nlohmann::json quality_to_json(const QualitySummary& s) {
   return j;
 }
 
+nlohmann::json quality_to_json(const QualitySummary& summary, double volume_mm3) {
+  nlohmann::json j = quality_to_json(summary);
+  j["volume_mm3"] = number(volume_mm3);
+  return j;
+}
+
 }  // namespace hexbite

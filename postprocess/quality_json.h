@@ -16,4 +16,8 @@ namespace hexbite {
 
 nlohmann::json quality_to_json(const QualitySummary& summary);
 
+// The same object plus `volume_mm3`, the mesh volume (hex_mesh_volume: exact for trilinear hexes, inverted
+// parts counted negative), as `hexbite quality --json` prints it. results.json keeps the object above.
+nlohmann::json quality_to_json(const QualitySummary& summary, double volume_mm3);
+
 }  // namespace hexbite

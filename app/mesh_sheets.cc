@@ -1,0 +1,96 @@
+#include "app/mesh_sheets.h"
+
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/progress.h"
+#include "mesher/cycle_elimination.h"
+#include "mesher/hex_mesh_io.h"
+#include "mesher/quad_surface_io.h"
+#include "postprocess/quality_json.h"
+
+namespace hexbite {
+
+namespace {
+
+std::string histogram_text(const std::vector<int>& counts) {
+  std::string s;
+  for (std::size_t d = 0; d < counts.size(); ++d)
+    if (counts[d] > 0) s += (s.empty() ? "" : ", ") + std::to_string(d) + ": " + std::to_string(counts[d]);
+  return s.empty() ? "none" : s;
+}
+
+std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
+  std::ostringstream out;
+  char line[256];
+  const QualitySummary& q = r.quality;
+  out << "Meshed " << o.quad_surface << " (cycle elimination, " << elimination_order_name(r.order)
+      << "): " << r.quads << " boundary quads, " << r.chords << " chords, " << r.eliminations
+      << " eliminations (" << r.external_sheets << " external sheets), " << r.hexes << " hexes, "
+      << r.interior_vertices << " interior nodes\n";
+  out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
+      << q.node_degree.max_edges << "\n";
+  out << "interior node degrees (hexes): " << histogram_text(q.node_degree.hexes) << "; maximum "
+      << q.node_degree.max_hexes << "\n";
+  std::snprintf(line, sizeof line,
+                "quality: scaled Jacobian min %.4f mean %.4f max %.4f; condition (cube = 3) min %.3f mean "
+                "%.3f max %.3f; Oddy mean %.3f max %.3f; %d inverted\n",
+                q.scaled_jacobian.min, q.scaled_jacobian.mean, q.scaled_jacobian.max, q.condition.min,
+                q.condition.mean, q.condition.max, q.oddy.mean, q.oddy.max, q.inverted);
+  out << line;
+  std::snprintf(line, sizeof line, "time: elimination %.2f s, embedding %.2f s\n", r.seconds_elimination,
+                r.seconds_embedding);
+  out << line;
+  return out.str();
+}
+
+}  // namespace
+
+void run_mesh_sheets(const MeshSheetsOptions& o) {
+  if (o.quad_surface.empty())
+    throw InputError(
+        "--method sheets needs --quad-surface Q.obj (a quad surface of a ball); meshing a triangle surface "
+        "with sheets (through a macro-element quad mesh) is not available yet: use --method grid for it");
+  const EliminationOrder order = parse_elimination_order(o.order);
+  const QuadSurface surface = read_quad_surface(o.quad_surface);
+  SheetMeshOptions options;
+  options.elimination.order = order;
+  SheetMeshReport report;
+  HexMesh mesh;
+  try {
+    mesh = mesh_by_cycle_elimination(surface, options, &report);
+  } catch (const InputError& e) {
+    throw InputError("'" + o.quad_surface + "': " + e.what());
+  }
+  const bool valid = report.quality.inverted == 0;
+  const bool write = valid || o.allow_invalid;
+  if (write) write_vtu(o.output, mesh);
+  if (o.json) {
+    nlohmann::json j;
+    j["quad_surface"] = o.quad_surface;
+    j["method"] = "sheets";
+    j["order"] = elimination_order_name(order);
+    j["quads"] = report.quads;
+    j["chords"] = report.chords;
+    j["eliminations"] = {{"single", report.eliminations}, {"k_step", 0}};
+    j["sheets"] = {{"external", report.external_sheets}, {"internal", 0}};
+    j["hexes"] = report.hexes;
+    j["interior_nodes"] = report.interior_vertices;
+    j["seconds"] = {{"elimination", report.seconds_elimination}, {"embedding", report.seconds_embedding}};
+    j["quality"] = quality_to_json(report.quality);
+    j["output"] = write ? nlohmann::json(o.output) : nlohmann::json();
+    std::cout << j.dump(2) << '\n';
+  } else if (!is_quiet()) {
+    std::cout << report_text(o, report);
+  }
+  if (!valid && !o.allow_invalid)
+    throw RunError(
+        std::to_string(report.quality.inverted) +
+        " hexes stay inverted after optimization; no mesh written (--allow-invalid writes it anyway)");
+  if (!o.json) info("wrote " + o.output);
+}
+
+}  // namespace hexbite

@@ -1,0 +1,341 @@
+#include "mesher/quad_check.h"
+
+#include <algorithm>
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/boyer_myrvold_planar_test.hpp>
+#include <numeric>
+#include <stdexcept>
+
+namespace hexbite {
+
+namespace {
+
+// Union-find with path halving; small and allocation-free after construction.
+class DisjointSets {
+ public:
+  explicit DisjointSets(int n) : parent_(static_cast<std::size_t>(n)) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  int find(int x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<int> parent_;
+};
+
+// Compressed adjacency of the non-isolated vertices.
+struct Csr {
+  std::vector<int> start;
+  std::vector<int> adj;
+  std::vector<int> active;  // vertices with at least one edge, ascending
+};
+
+Csr make_csr(int n, const std::vector<std::array<int, 2>>& edges) {
+  Csr g;
+  g.start.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (const auto& e : edges) {
+    ++g.start[e[0] + 1];
+    ++g.start[e[1] + 1];
+  }
+  for (int v = 0; v < n; ++v) g.start[v + 1] += g.start[v];
+  g.adj.resize(g.start[n]);
+  std::vector<int> fill(g.start.begin(), g.start.end() - 1);
+  for (const auto& e : edges) {
+    g.adj[fill[e[0]]++] = e[1];
+    g.adj[fill[e[1]]++] = e[0];
+  }
+  for (int v = 0; v < n; ++v)
+    if (g.start[v + 1] > g.start[v]) g.active.push_back(v);
+  return g;
+}
+
+// True when the active vertices other than `removed` form a connected graph without articulation points.
+// Iterative Tarjan low-point search; the work arrays are passed in so that the n calls of the
+// 3-connectivity test do not allocate.
+bool biconnected_without(const Csr& g, int removed, std::vector<int>& disc, std::vector<int>& low,
+                         std::vector<std::array<int, 2>>& stack) {
+  std::fill(disc.begin(), disc.end(), -1);
+  int root = -1;
+  for (int v : g.active)
+    if (v != removed) {
+      root = v;
+      break;
+    }
+  if (root < 0) return true;
+  int time = 0;
+  int root_children = 0;
+  disc[root] = low[root] = time++;
+  stack.clear();
+  stack.push_back({root, g.start[root]});
+  while (!stack.empty()) {
+    auto& [v, next] = stack.back();
+    if (next < g.start[v + 1]) {
+      const int w = g.adj[next++];
+      if (w == removed) continue;
+      if (disc[w] < 0) {
+        disc[w] = low[w] = time++;
+        if (v == root) ++root_children;
+        stack.push_back({w, g.start[w]});
+      } else {
+        low[v] = std::min(low[v], disc[w]);
+      }
+    } else {
+      const int child = v;
+      stack.pop_back();
+      if (stack.empty()) break;
+      const int parent = stack.back()[0];
+      low[parent] = std::min(low[parent], low[child]);
+      // A non-root vertex is an articulation point when some child cannot reach above it.
+      if (parent != root && low[child] >= disc[parent]) return false;
+    }
+  }
+  if (root_children > 1) return false;
+  for (int v : g.active)
+    if (v != removed && disc[v] < 0) return false;  // disconnected
+  return true;
+}
+
+}  // namespace
+
+QuadEdges build_quad_edges(const std::vector<std::array<int, 4>>& quads) {
+  struct Side {
+    int a, b, quad, local;
+  };
+  std::vector<Side> sides;
+  sides.reserve(quads.size() * 4);
+  for (int q = 0; q < static_cast<int>(quads.size()); ++q)
+    for (int k = 0; k < 4; ++k) {
+      const int u = quads[q][k], v = quads[q][(k + 1) % 4];
+      sides.push_back({std::min(u, v), std::max(u, v), q, k});
+    }
+  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
+    return std::tie(x.a, x.b, x.quad, x.local) < std::tie(y.a, y.b, y.quad, y.local);
+  });
+  QuadEdges r;
+  r.quad_edges.assign(quads.size(), {-1, -1, -1, -1});
+  for (std::size_t i = 0; i < sides.size(); ++i) {
+    if (i == 0 || sides[i].a != sides[i - 1].a || sides[i].b != sides[i - 1].b) {
+      r.edges.push_back({sides[i].a, sides[i].b});
+      r.edge_quads.emplace_back();
+    }
+    const int e = static_cast<int>(r.edges.size()) - 1;
+    r.edge_quads[e].push_back({sides[i].quad, sides[i].local});
+    r.quad_edges[sides[i].quad][sides[i].local] = e;
+  }
+  return r;
+}
+
+std::vector<Chord> find_chords(const std::vector<std::array<int, 4>>& quads, const QuadEdges& qe) {
+  const int ne = static_cast<int>(qe.edges.size());
+  for (int e = 0; e < ne; ++e)
+    if (qe.edge_quads[e].size() != 2 || qe.edge_quads[e][0][0] == qe.edge_quads[e][1][0])
+      throw std::invalid_argument("find_chords: every edge must lie in exactly two different quads");
+  std::vector<char> seen(static_cast<std::size_t>(ne), 0);
+  std::vector<int> crossings(quads.size(), 0);
+  std::vector<Chord> chords;
+  for (int start = 0; start < ne; ++start) {
+    if (seen[start]) continue;
+    Chord c;
+    int e = start;
+    int q = qe.edge_quads[e][0][0];
+    int local = qe.edge_quads[e][0][1];
+    do {
+      seen[e] = 1;
+      c.quads.push_back(q);
+      c.edges.push_back(e);
+      const int out = qe.quad_edges[q][(local + 2) % 4];
+      const auto& pair = qe.edge_quads[out];
+      // Leave through the opposite side into the other quad of that edge.
+      const int slot = pair[0][0] == q && pair[0][1] == (local + 2) % 4 ? 1 : 0;
+      e = out;
+      q = pair[slot][0];
+      local = pair[slot][1];
+    } while (e != start);
+    for (int x : c.quads)
+      if (++crossings[x] == 2) c.repeated_quads.push_back(x);
+    for (int x : c.quads) crossings[x] = 0;
+    std::sort(c.repeated_quads.begin(), c.repeated_quads.end());
+    chords.push_back(std::move(c));
+  }
+  return chords;
+}
+
+bool is_planar_graph(int n, const std::vector<std::array<int, 2>>& edges) {
+  boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS> g(static_cast<std::size_t>(n));
+  for (const auto& e : edges) boost::add_edge(e[0], e[1], g);
+  return boost::boyer_myrvold_planarity_test(g);
+}
+
+bool is_three_connected(int n, const std::vector<std::array<int, 2>>& edges) {
+  const Csr g = make_csr(n, edges);
+  if (g.active.size() < 4) return false;
+  std::vector<int> disc(static_cast<std::size_t>(n)), low(static_cast<std::size_t>(n));
+  std::vector<std::array<int, 2>> stack;
+  for (int v : g.active)
+    if (g.start[v + 1] - g.start[v] < 3) return false;  // its neighbours separate it
+  for (int removed : g.active)
+    if (!biconnected_without(g, removed, disc, low, stack)) return false;
+  return true;
+}
+
+QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::string& file) {
+  QuadSurfaceReport r;
+  r.file = file;
+  const auto& quads = surface.quads;
+  const int nq = static_cast<int>(quads.size());
+  const int nv = static_cast<int>(surface.vertices.size());
+  r.quads = nq;
+  for (const auto& q : quads)
+    for (int v : q)
+      if (v < 0 || v >= nv) throw std::invalid_argument("check_quad_surface: vertex index out of range");
+
+  std::vector<char> used(static_cast<std::size_t>(nv), 0);
+  for (const auto& q : quads)
+    for (int v : q) used[v] = 1;
+  r.vertices = static_cast<int>(std::count(used.begin(), used.end(), 1));
+  r.unused_vertices = nv - r.vertices;
+
+  for (const auto& q : quads) {
+    std::array<int, 4> s = q;
+    std::sort(s.begin(), s.end());
+    if (std::adjacent_find(s.begin(), s.end()) != s.end()) ++r.degenerate_quads;
+  }
+  {
+    std::vector<std::pair<std::array<int, 4>, int>> sorted;
+    for (int q = 0; q < nq; ++q) {
+      std::array<int, 4> s = quads[q];
+      std::sort(s.begin(), s.end());
+      sorted.push_back({s, q});
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i].first == sorted[i - 1].first) ++r.duplicate_quads;
+  }
+
+  const QuadEdges qe = build_quad_edges(quads);
+  r.edges = static_cast<int>(qe.edges.size());
+  DisjointSets components(nq);
+  // One slot per quad corner; corners of the same vertex in quads joined across an edge at that vertex
+  // belong to the same fan, so a vertex with corners in several fans is non-manifold.
+  DisjointSets fans(4 * nq);
+  std::vector<std::array<int, 2>> sharing;  // quad pairs across manifold edges
+  for (std::size_t e = 0; e < qe.edges.size(); ++e) {
+    const auto& list = qe.edge_quads[e];
+    if (list.size() == 1) ++r.open_edges;
+    if (list.size() > 2) ++r.non_manifold_edges;
+    for (std::size_t i = 1; i < list.size(); ++i) components.unite(list[0][0], list[i][0]);
+    if (list.size() != 2) continue;
+    const auto [q1, k1] = list[0];
+    const auto [q2, k2] = list[1];
+    sharing.push_back({std::min(q1, q2), std::max(q1, q2)});
+    // Quads are oriented consistently when they traverse their shared edge in opposite directions.
+    const bool same_direction = quads[q1][k1] == quads[q2][k2];
+    if (same_direction) ++r.inconsistent_edges;
+    for (int v : qe.edges[e]) {
+      int c1 = -1, c2 = -1;
+      for (int k = 0; k < 4; ++k) {
+        if (quads[q1][k] == v) c1 = k;
+        if (quads[q2][k] == v) c2 = k;
+      }
+      fans.unite(4 * q1 + c1, 4 * q2 + c2);
+    }
+  }
+  {
+    std::vector<int> first_fan(static_cast<std::size_t>(nv), -1);
+    std::vector<char> bad(static_cast<std::size_t>(nv), 0);
+    for (int q = 0; q < nq; ++q)
+      for (int k = 0; k < 4; ++k) {
+        const int v = quads[q][k];
+        const int f = fans.find(4 * q + k);
+        if (first_fan[v] < 0)
+          first_fan[v] = f;
+        else if (first_fan[v] != f)
+          bad[v] = 1;
+      }
+    r.non_manifold_vertices = static_cast<int>(std::count(bad.begin(), bad.end(), 1));
+  }
+  for (int q = 0; q < nq; ++q)
+    if (components.find(q) == q) ++r.components;
+  std::sort(sharing.begin(), sharing.end());
+  for (std::size_t i = 1; i < sharing.size(); ++i)
+    if (sharing[i] == sharing[i - 1] && (i < 2 || sharing[i - 2] != sharing[i])) ++r.quad_pairs_sharing_edges;
+
+  r.closed = r.open_edges == 0;
+  r.manifold = r.non_manifold_edges == 0 && r.non_manifold_vertices == 0;
+  r.consistently_oriented = r.inconsistent_edges == 0;
+  r.euler_characteristic = r.vertices - r.edges + nq;
+  if (r.closed && r.manifold && r.consistently_oriented && r.components == 1 && r.degenerate_quads == 0)
+    r.genus = (2 - r.euler_characteristic) / 2;
+  r.ball = r.genus == 0;
+  r.even = nq % 2 == 0;
+  r.simple = r.degenerate_quads == 0 && r.quad_pairs_sharing_edges == 0 && r.duplicate_quads == 0 &&
+             r.non_manifold_edges == 0;
+  r.planar = is_planar_graph(nv, qe.edges);
+  r.three_connected = is_three_connected(nv, qe.edges);
+  if (r.closed && r.non_manifold_edges == 0 && r.degenerate_quads == 0) {
+    r.chords_computed = true;
+    r.chords = find_chords(quads, qe);
+    for (int c = 0; c < static_cast<int>(r.chords.size()); ++c)
+      if (!r.chords[c].simple()) r.self_intersecting_chords.push_back(c);
+  }
+
+  auto count = [](int n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+  };
+  if (!r.even)
+    r.problems.push_back(
+        "odd number of quads (" + std::to_string(nq) +
+        "): a hex mesh of a ball needs an even number of boundary quads (Thurston, Mitchell); "
+        "refine or remesh the quad surface");
+  if (!r.closed)
+    r.problems.push_back("not closed: " + count(r.open_edges, "open edge", "open edges") +
+                         " (edges in only one quad); close the holes");
+  if (!r.manifold)
+    r.problems.push_back("not manifold: " + count(r.non_manifold_edges, "edge", "edges") +
+                         " in more than two quads, " +
+                         count(r.non_manifold_vertices, "non-manifold vertex", "non-manifold vertices"));
+  if (r.degenerate_quads > 0)
+    r.problems.push_back(count(r.degenerate_quads, "degenerate quad", "degenerate quads") +
+                         " (a repeated vertex)");
+  if (r.closed && r.manifold && !r.consistently_oriented)
+    r.problems.push_back("inconsistent orientation: " + count(r.inconsistent_edges, "edge", "edges") +
+                         " traversed in the same direction by both quads");
+  if (r.components > 1)
+    r.problems.push_back("not a ball: " + std::to_string(r.components) + " separate components");
+  else if (r.genus > 0)
+    r.problems.push_back("not a ball: genus " + std::to_string(r.genus) + " (Euler characteristic " +
+                         std::to_string(r.euler_characteristic) +
+                         "); the sheet mesher needs a topological "
+                         "ball (genus 0); use the grid method");
+  if (r.unused_vertices > 0)
+    r.problems.push_back(count(r.unused_vertices, "vertex", "vertices") + " in no quad; remove them");
+  if (r.manifold && r.degenerate_quads == 0 && !r.simple)
+    r.problems.push_back("graph not simple: " +
+                         count(r.quad_pairs_sharing_edges, "pair of quads shares", "pairs of quads share") +
+                         " two or more edges, " +
+                         count(r.duplicate_quads, "duplicate quad", "duplicate quads"));
+  if (r.ball && r.simple && !r.three_connected)
+    r.problems.push_back(
+        "graph not 3-connected: removing two vertices disconnects it (a vertex of degree 2 "
+        "or a pinch); the elimination needs a 3-connected graph");
+  for (int c : r.self_intersecting_chords) {
+    const Chord& ch = r.chords[c];
+    std::string quads_text;
+    for (std::size_t i = 0; i < ch.repeated_quads.size() && i < 10; ++i)
+      quads_text += (i ? ", " : "") + std::to_string(ch.repeated_quads[i]);
+    if (ch.repeated_quads.size() > 10) quads_text += ", ...";
+    r.problems.push_back("chord " + std::to_string(c) + " (length " + std::to_string(ch.length()) +
+                         ") self-intersects: it crosses quads " + quads_text +
+                         " twice; only simple chords can be eliminated: remesh there or use the grid method");
+  }
+  return r;
+}
+
+}  // namespace hexbite

@@ -1,0 +1,248 @@
+#include "mesher/quad_surface_io.h"
+
+#include <vtkCellArray.h>
+#include <vtkNew.h>
+#include <vtkObject.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataReader.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+
+namespace hexbite {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quoted(const std::string& path) {
+  return "'" + path + "'";
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+void require_readable_nonempty(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw InputError("quad surface file " + quoted(path) +
+                     " does not exist: check the path and the spelling");
+  if (!fs::is_regular_file(path, ec))
+    throw InputError("quad surface file " + quoted(path) + " is not a regular file (a folder?): give a file");
+  if (fs::file_size(path, ec) == 0)
+    throw InputError("quad surface file " + quoted(path) + " is empty (0 bytes): export it again");
+}
+
+void require_finite(const std::string& path, const std::string& where, const Vec3& p) {
+  for (double c : p)
+    if (!std::isfinite(c))
+      throw InputError(quoted(path) + " " + where +
+                       ": a coordinate is NaN or infinite; every coordinate must be a finite number");
+}
+
+void require_quads(const std::string& path, const QuadSurface& s) {
+  if (s.quads.empty())
+    throw InputError("quad surface file " + quoted(path) +
+                     " contains no quads: export the surface as a quad mesh");
+}
+
+bool parse_double(std::string_view token, double& value) {
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  const char* end = token.data() + token.size();
+  auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  return ec == std::errc() && ptr == end;
+}
+
+// An OBJ face corner is "v", "v/vt", "v//vn" or "v/vt/vn"; only the vertex index matters here.
+bool parse_index(std::string_view token, long& value) {
+  token = token.substr(0, token.find('/'));
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  const char* end = token.data() + token.size();
+  auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  return ec == std::errc() && ptr == end && !token.empty();
+}
+
+QuadSurface read_obj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open quad surface file " + quoted(path) + ": check its permissions");
+  QuadSurface s;
+  // Face corners are checked against the vertex count at the end, because OBJ allows faces to refer to
+  // vertices defined later; the line of each face is kept for that message.
+  std::vector<int> face_line;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream tokens(line);
+    std::string key;
+    if (!(tokens >> key) || key[0] == '#') continue;
+    const std::string where = "line " + std::to_string(line_no);
+    std::vector<std::string> rest;
+    for (std::string t; tokens >> t;) rest.push_back(t);
+    if (key == "v") {
+      Vec3 p{};
+      if (rest.size() < 3 || !parse_double(rest[0], p[0]) || !parse_double(rest[1], p[1]) ||
+          !parse_double(rest[2], p[2]))
+        throw InputError(quoted(path) + " " + where + ": malformed vertex line '" + line +
+                         "': expected 'v x y z'");
+      require_finite(path, where, p);
+      s.vertices.push_back(p);
+    } else if (key == "f") {
+      if (rest.size() != 4)
+        throw InputError(quoted(path) + " " + where + ": face with " + std::to_string(rest.size()) +
+                         " corners ('" + line +
+                         "'); a quad surface holds only quads (4 corners): remesh "
+                         "the surface with quads or use the grid method for triangle surfaces");
+      std::array<int, 4> q{};
+      for (int k = 0; k < 4; ++k) {
+        long index = 0;
+        if (!parse_index(rest[k], index) || index == 0)
+          throw InputError(quoted(path) + " " + where + ": malformed face line '" + line +
+                           "': corners are 1-based vertex indices");
+        // Negative indices count back from the last vertex read so far.
+        const long resolved = index > 0 ? index - 1 : static_cast<long>(s.vertices.size()) + index;
+        if (resolved < 0)
+          throw InputError(quoted(path) + " " + where + ": face index " + std::to_string(index) +
+                           " refers to a vertex before the first one");
+        q[k] = static_cast<int>(resolved);
+      }
+      s.quads.push_back(q);
+      face_line.push_back(line_no);
+    } else if (key == "vn" || key == "vt" || key == "vp" || key == "o" || key == "g" || key == "s" ||
+               key == "usemtl" || key == "mtllib") {
+      continue;  // normals, texture coordinates, groups and materials do not affect the mesh
+    } else if (key == "l" || key == "p") {
+      throw InputError(quoted(path) + " " + where + ": '" + key +
+                       "' elements (lines or points) are not part of a quad surface");
+    } else {
+      throw InputError(quoted(path) + " " + where + ": unknown OBJ line '" + line + "'");
+    }
+  }
+  for (std::size_t f = 0; f < s.quads.size(); ++f)
+    for (int v : s.quads[f])
+      if (v >= static_cast<int>(s.vertices.size()))
+        throw InputError(quoted(path) + " line " + std::to_string(face_line[f]) + ": face index " +
+                         std::to_string(v + 1) + " is out of range (the file has " +
+                         std::to_string(s.vertices.size()) + " vertices)");
+  require_quads(path, s);
+  return s;
+}
+
+QuadSurface from_polydata(const std::string& path, vtkPolyData* poly) {
+  QuadSurface s;
+  if (!poly || poly->GetNumberOfPoints() == 0)
+    throw InputError(quoted(path) + " is not VTK polydata with points (unreadable or empty file)");
+  if (poly->GetNumberOfStrips() > 0)
+    throw InputError(quoted(path) + " holds triangle strips; a quad surface holds only quads");
+  const vtkIdType n = poly->GetNumberOfPoints();
+  s.vertices.resize(static_cast<std::size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i) {
+    double p[3];
+    poly->GetPoint(i, p);
+    s.vertices[std::size_t(i)] = {p[0], p[1], p[2]};
+    require_finite(path, "point " + std::to_string(i) + " (0-based)", s.vertices[std::size_t(i)]);
+  }
+  vtkCellArray* polys = poly->GetPolys();
+  vtkIdType npts = 0;
+  const vtkIdType* ids = nullptr;
+  vtkIdType face = 0;
+  for (polys->InitTraversal(); polys->GetNextCell(npts, ids); ++face) {
+    if (npts != 4)
+      throw InputError(quoted(path) + " face " + std::to_string(face) + " (0-based) has " +
+                       std::to_string(npts) + " corners; a quad surface holds only quads (4 corners)");
+    std::array<int, 4> q{};
+    for (int k = 0; k < 4; ++k) {
+      if (ids[k] < 0 || ids[k] >= n)
+        throw InputError(quoted(path) + " face " + std::to_string(face) + " (0-based) refers to point " +
+                         std::to_string(ids[k]) + ", out of range (the file has " + std::to_string(n) +
+                         " points)");
+      q[k] = static_cast<int>(ids[k]);
+    }
+    s.quads.push_back(q);
+  }
+  require_quads(path, s);
+  return s;
+}
+
+// VTK readers print their own errors; they are silenced here and replaced by one InputError, because the
+// reader's error code says enough to tell a broken file from a good one.
+class ScopedVtkSilence {
+ public:
+  ScopedVtkSilence() : previous_(vtkObject::GetGlobalWarningDisplay()) {
+    vtkObject::GlobalWarningDisplayOff();
+  }
+  ~ScopedVtkSilence() { vtkObject::SetGlobalWarningDisplay(previous_); }
+  ScopedVtkSilence(const ScopedVtkSilence&) = delete;
+  ScopedVtkSilence& operator=(const ScopedVtkSilence&) = delete;
+
+ private:
+  int previous_;
+};
+
+QuadSurface read_vtp(const std::string& path) {
+  ScopedVtkSilence silence;
+  vtkNew<vtkXMLPolyDataReader> reader;
+  if (!reader->CanReadFile(path.c_str()))
+    throw InputError(quoted(path) + " is not a VTK XML polydata (.vtp) file");
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0)
+    throw InputError(quoted(path) + " could not be read as VTK XML polydata (truncated or corrupt file)");
+  return from_polydata(path, reader->GetOutput());
+}
+
+QuadSurface read_legacy_vtk(const std::string& path) {
+  ScopedVtkSilence silence;
+  vtkNew<vtkPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  if (!reader->IsFilePolyData())
+    throw InputError(quoted(path) + " is not a legacy VTK polydata file (DATASET POLYDATA)");
+  reader->Update();
+  if (reader->GetErrorCode() != 0)
+    throw InputError(quoted(path) + " could not be read as legacy VTK polydata (truncated or corrupt file)");
+  return from_polydata(path, reader->GetOutput());
+}
+
+}  // namespace
+
+QuadSurface read_quad_surface(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext != ".obj" && ext != ".vtp" && ext != ".vtk")
+    throw InputError("cannot read quad surface " + quoted(path) + ": " +
+                     (ext.empty() ? std::string("no extension") : "unknown extension '" + ext + "'") +
+                     "; accepted quad surface formats are .obj, .vtp and .vtk (any case)");
+  require_readable_nonempty(path);
+  if (ext == ".obj") return read_obj(path);
+  if (ext == ".vtp") return read_vtp(path);
+  return read_legacy_vtk(path);
+}
+
+void write_quad_obj(const std::string& path, const QuadSurface& surface) {
+  std::string text = "# quad surface written by hexbite\n";
+  char line[128];
+  for (const Vec3& p : surface.vertices) {
+    std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+    text += line;
+  }
+  for (const auto& q : surface.quads) {
+    std::snprintf(line, sizeof line, "f %d %d %d %d\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+    text += line;
+  }
+  write_file_atomically(path, text);
+}
+
+}  // namespace hexbite

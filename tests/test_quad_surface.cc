@@ -1,0 +1,204 @@
+// Quad surfaces: reading and writing, the combinatorial check (closed, manifold, genus, even, simple,
+// 3-connected, chords) and `hexbite quad check`.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "common/error.h"
+#include "mesher/quad_check.h"
+#include "mesher/quad_surface_io.h"
+#include "tests/quad_test_surfaces.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+std::vector<int> sorted_lengths(const QuadSurfaceReport& r) {
+  std::vector<int> lengths;
+  for (const Chord& c : r.chords) lengths.push_back(c.length());
+  std::sort(lengths.begin(), lengths.end());
+  return lengths;
+}
+
+// An n x m x k block has one chord per unit slab in each direction: the ring around the slab. A slab across
+// x crosses the four faces parallel to x, so its chord has length 2 (m + k); likewise for y and z. So there
+// are n + m + k chords and their lengths sum to 2 * quads = 4 (nm + mk + nk).
+TEST(QuadCheck, BlockBoundaryChordCountsAndLengths) {
+  for (const std::array<int, 3> dims : {std::array<int, 3>{1, 1, 1}, {2, 3, 4}, {3, 1, 2}}) {
+    const auto [n, m, k] = dims;
+    const QuadSurfaceReport r = check_quad_surface(test::block_surface(n, m, k), "block");
+    SCOPED_TRACE(std::to_string(n) + "x" + std::to_string(m) + "x" + std::to_string(k));
+    EXPECT_TRUE(r.usable());
+    EXPECT_EQ(r.quads, 2 * (n * m + m * k + n * k));
+    EXPECT_EQ(r.vertices, r.quads + 2);
+    EXPECT_TRUE(r.closed && r.manifold && r.consistently_oriented && r.even && r.simple);
+    EXPECT_EQ(r.genus, 0);
+    EXPECT_TRUE(r.ball);
+    EXPECT_TRUE(r.planar);
+    EXPECT_TRUE(r.three_connected);
+    std::vector<int> expected;
+    for (int i = 0; i < n; ++i) expected.push_back(2 * (m + k));
+    for (int i = 0; i < m; ++i) expected.push_back(2 * (n + k));
+    for (int i = 0; i < k; ++i) expected.push_back(2 * (n + m));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(sorted_lengths(r), expected);
+    EXPECT_TRUE(r.self_intersecting_chords.empty());
+  }
+}
+
+// The L of three unit cubes (2 x 2 x 1 minus one cell) has 14 quads: one horizontal chord around the L
+// (length 8) and, per direction x and y, a chord of length 6 around the two-cube column and one of length 4
+// around the single cube.
+TEST(QuadCheck, LShapedPolycube) {
+  const QuadSurface s = test::polycube_surface(2, 2, 1, [](int i, int j, int) { return i == 0 || j == 0; });
+  const QuadSurfaceReport r = check_quad_surface(test::perturbed(s, 0.1), "L");
+  EXPECT_TRUE(r.usable());
+  EXPECT_EQ(r.quads, 14);
+  EXPECT_TRUE(r.three_connected);
+  EXPECT_EQ(sorted_lengths(r), (std::vector<int>{4, 4, 6, 6, 8}));
+}
+
+TEST(QuadCheck, GraphTests) {
+  const std::vector<std::array<int, 2>> k4 = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  EXPECT_TRUE(is_three_connected(4, k4));
+  EXPECT_TRUE(is_planar_graph(4, k4));
+  // A 6-cycle with one chord is 2-connected only.
+  EXPECT_FALSE(is_three_connected(6, {{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 5}, {5, 0}, {0, 3}}));
+  // Two K4 glued at two vertices {0, 1}: removing 0 and 1 separates them.
+  EXPECT_FALSE(is_three_connected(
+      6, {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}, {0, 4}, {0, 5}, {1, 4}, {1, 5}, {4, 5}}));
+  std::vector<std::array<int, 2>> k5;
+  for (int a = 0; a < 5; ++a)
+    for (int b = a + 1; b < 5; ++b) k5.push_back({a, b});
+  EXPECT_FALSE(is_planar_graph(5, k5));
+  EXPECT_TRUE(is_three_connected(5, k5));
+}
+
+// A cube whose top quad is split into two quads through an interior vertex: 7 quads.
+QuadSurface odd_surface() {
+  QuadSurface s = test::block_surface(1, 1, 1);
+  std::array<int, 4> top{};
+  for (auto& q : s.quads)
+    if (s.vertices[q[0]][2] == 1 && s.vertices[q[1]][2] == 1 && s.vertices[q[2]][2] == 1) top = q;
+  s.quads.erase(std::find(s.quads.begin(), s.quads.end(), top));
+  const int o = static_cast<int>(s.vertices.size());
+  s.vertices.push_back({0.4, 0.6, 1.0});
+  s.quads.push_back({top[0], top[1], top[2], o});
+  s.quads.push_back({top[0], o, top[2], top[3]});
+  return s;
+}
+
+TEST(QuadCheck, ProblemsAreNamed) {
+  const QuadSurfaceReport odd = check_quad_surface(odd_surface(), "odd");
+  EXPECT_FALSE(odd.even);
+  ASSERT_FALSE(odd.problems.empty());
+  EXPECT_NE(odd.problems[0].find("odd number of quads (7)"), std::string::npos);
+
+  QuadSurface open = test::block_surface(2, 1, 1);
+  open.quads.resize(open.quads.size() - 2);
+  const QuadSurfaceReport o = check_quad_surface(open, "open");
+  EXPECT_FALSE(o.closed);
+  EXPECT_GT(o.open_edges, 0);
+  EXPECT_FALSE(o.ball);
+
+  const QuadSurfaceReport t = check_quad_surface(test::torus_surface(6, 4), "torus");
+  EXPECT_TRUE(t.closed && t.manifold && t.even);
+  EXPECT_EQ(t.euler_characteristic, 0);
+  EXPECT_EQ(t.genus, 1);
+  EXPECT_FALSE(t.ball);
+
+  const QuadSurfaceReport si = check_quad_surface(test::self_intersecting_surface(), "twisted");
+  EXPECT_TRUE(si.ball && si.even && si.simple && si.three_connected);
+  EXPECT_EQ(si.quads, 22);
+  ASSERT_EQ(si.self_intersecting_chords.size(), 1u);
+  const Chord& c = si.chords[si.self_intersecting_chords[0]];
+  EXPECT_EQ(c.length(), 20);
+  EXPECT_FALSE(c.repeated_quads.empty());
+  for (int q : c.repeated_quads) EXPECT_EQ(std::count(c.quads.begin(), c.quads.end(), q), 2);
+  EXPECT_FALSE(si.usable());
+}
+
+TEST(QuadSurfaceIo, ObjRoundTripAndDeterminism) {
+  const std::string dir = test::temp_dir();
+  const QuadSurface s = test::perturbed(test::block_surface(2, 1, 3), 0.05);
+  write_quad_obj(dir + "/a.obj", s);
+  write_quad_obj(dir + "/b.obj", s);
+  EXPECT_EQ(test::read_file(dir + "/a.obj"), test::read_file(dir + "/b.obj"));
+  const QuadSurface back = read_quad_surface(dir + "/a.obj");
+  EXPECT_EQ(back.vertices, s.vertices);  // %.17g round-trips exactly
+  EXPECT_EQ(back.quads, s.quads);
+}
+
+std::string error_of(const std::string& path) {
+  try {
+    read_quad_surface(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(QuadSurfaceIo, RejectsNonQuadsWithTheirPlace) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n# comment\nf 1 2 4 3\nf 1 2 3\n");
+  const std::string e = error_of(dir + "/tri.obj");
+  EXPECT_NE(e.find("tri.obj' line 7"), std::string::npos) << e;
+  EXPECT_NE(e.find("3 corners"), std::string::npos) << e;
+  test::write_file(dir + "/range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 9\n");
+  EXPECT_NE(error_of(dir + "/range.obj").find("line 4: face index 9 is out of range"), std::string::npos);
+  EXPECT_NE(error_of(dir + "/missing.obj").find("does not exist"), std::string::npos);
+  EXPECT_NE(error_of(dir + "/x.stl").find("accepted quad surface formats"), std::string::npos);
+  test::write_file(dir + "/slash.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1/1 2//2 -2 4\n");
+  const QuadSurface slash = read_quad_surface(dir + "/slash.obj");
+  EXPECT_EQ(slash.quads.at(0), (std::array<int, 4>{0, 1, 2, 3}));
+}
+
+TEST(QuadSurfaceIo, LegacyVtkPolydata) {
+  const std::string dir = test::temp_dir();
+  const std::string head =
+      "# vtk DataFile Version 3.0\nquads\nASCII\nDATASET POLYDATA\nPOINTS 5 double\n0 0 0\n1 0 0\n1 1 0\n"
+      "0 1 0\n2 0 0\n";
+  test::write_file(dir + "/q.vtk", head + "POLYGONS 1 5\n4 0 1 2 3\n");
+  const QuadSurface q = read_quad_surface(dir + "/q.vtk");
+  ASSERT_EQ(q.quads.size(), 1u);
+  EXPECT_EQ(q.quads[0], (std::array<int, 4>{0, 1, 2, 3}));
+  EXPECT_EQ(q.vertices[4], (Vec3{2, 0, 0}));
+  test::write_file(dir + "/t.vtk", head + "POLYGONS 2 9\n4 0 1 2 3\n3 1 4 2\n");
+  const std::string e = error_of(dir + "/t.vtk");
+  EXPECT_NE(e.find("face 1 (0-based) has 3 corners"), std::string::npos) << e;
+}
+
+TEST(QuadCheckCli, ExitCodesAndMessages) {
+  const std::string dir = test::temp_dir();
+  write_quad_obj(dir + "/block.obj", test::block_surface(2, 3, 4));
+  const auto ok = test::run_hexbite({"quad", "check", dir + "/block.obj", "--json"});
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  const auto j = nlohmann::json::parse(ok.out);
+  EXPECT_EQ(j["chords"].size(), 9u);
+  EXPECT_EQ(j["quads"], 52);
+  EXPECT_EQ(j["three_connected"], true);
+  EXPECT_EQ(j["genus"], 0);
+
+  struct Case {
+    std::string name;
+    QuadSurface surface;
+    std::string message;
+  };
+  QuadSurface open = test::block_surface(2, 1, 1);
+  open.quads.resize(open.quads.size() - 2);
+  const std::vector<Case> cases = {
+      {"odd", odd_surface(), "odd number of quads (7)"},
+      {"open", open, "not closed: "},
+      {"torus", test::torus_surface(6, 4), "not a ball: genus 1"},
+      {"twisted", test::self_intersecting_surface(), "(length 20) self-intersects"}};
+  for (const Case& c : cases) {
+    write_quad_obj(dir + "/" + c.name + ".obj", c.surface);
+    const auto r = test::run_hexbite({"quad", "check", dir + "/" + c.name + ".obj"});
+    EXPECT_EQ(r.exit_code, 2) << c.name;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_NE(r.out.find("usable for --method sheets: no"), std::string::npos) << c.name;  // report printed
+  }
+}
+
+}  // namespace
+}  // namespace hexbite
