@@ -24,15 +24,9 @@ using detail::cross;
 using detail::dot;
 using detail::sub;
 
-Vec3 add(const Vec3& a, const Vec3& b) {
-  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-}
-Vec3 scale(const Vec3& a, double s) {
-  return {a[0] * s, a[1] * s, a[2] * s};
-}
-double norm(const Vec3& a) {
-  return std::sqrt(dot(a, a));
-}
+using vec3::add;
+using vec3::norm;
+using vec3::scale;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -22,6 +22,7 @@
 #include <limits>
 
 #include "mesher/tri_surface.h"
+#include "mesher/vec3.h"
 
 namespace hexbite {
 
@@ -50,15 +51,9 @@ struct HexQuality {
 
 namespace detail {
 
-inline Vec3 sub(const Vec3& a, const Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-inline double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
+using vec3::cross;
+using vec3::dot;
+using vec3::sub;
 
 }  // namespace detail
 
