@@ -1,8 +1,9 @@
 // The hexbite command line: parses options with CLI11 and maps errors to exit codes
-// (0 ok, 1 failed run, 2 bad input or usage). MPI is initialized once here for every command, so that
+// (0 ok, 1 failed run, 2 bad input or usage). MPI is initialized here for the commands that solve, so that
 // `mpirun -np N hexbite run ...` works; without mpirun the program is a single rank.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "app/commands.h"
@@ -14,8 +15,24 @@
 #define HEXBITE_VERSION "unknown"
 #endif
 
+namespace {
+
+// Starting MPI (and with it PETSc, p4est and Trilinos) costs about half a second, which every quick command
+// would pay for nothing: only `run` calls the solver. The main program's own options are all flags, so the
+// first argument that is not an option names the subcommand.
+bool command_uses_solver(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!arg.empty() && arg[0] != '-') return arg == "run";
+  }
+  return false;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  const hexbite::MpiSession mpi(argc, argv);
+  std::optional<hexbite::MpiSession> mpi;
+  if (command_uses_solver(argc, argv)) mpi.emplace(argc, argv);
   // Only rank 0 reports progress and results; errors are reported by every rank that meets them.
   const bool root = hexbite::MpiSession::rank() == 0;
   const std::string rank_prefix =

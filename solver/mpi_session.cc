@@ -59,11 +59,14 @@ MpiSession::~MpiSession() {
   }
 }
 
+// Without a session (commands that never solve skip MPI's start-up) the program is rank 0 of 1.
 int MpiSession::rank() {
+  if (!dealii::Utilities::MPI::job_supports_mpi()) return 0;
   return static_cast<int>(dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD));
 }
 
 int MpiSession::size() {
+  if (!dealii::Utilities::MPI::job_supports_mpi()) return 1;
   return static_cast<int>(dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD));
 }
 

@@ -17,7 +17,7 @@ class MpiSession {
   MpiSession(const MpiSession&) = delete;
   MpiSession& operator=(const MpiSession&) = delete;
 
-  // This process's rank in MPI_COMM_WORLD and the number of ranks.
+  // This process's rank in MPI_COMM_WORLD and the number of ranks (0 and 1 when no session was started).
   static int rank();
   static int size();
 };
