@@ -3,20 +3,13 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
+#include "common/paths.h"
 #include "common/progress.h"
 #include "mesher/surface_io.h"
 #include "mesher/units.h"
 #include "postprocess/render.h"
 
 namespace hexbite {
-
-namespace {
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-}  // namespace
 
 void add_render_command(CLI::App& app) {
   auto* cmd =

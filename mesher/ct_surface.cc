@@ -26,6 +26,7 @@
 #include <limits>
 
 #include "common/error.h"
+#include "common/paths.h"
 
 namespace hexbite {
 
@@ -34,11 +35,6 @@ namespace fs = std::filesystem;
 namespace {
 
 enum class VolumeFormat { kMetaImage, kNifti };
-
-// The full extension decides the format; ".nii.gz" has two parts, so the stem alone is not enough.
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 struct FormatAndExtension {
   VolumeFormat format;

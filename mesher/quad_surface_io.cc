@@ -18,22 +18,13 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/paths.h"
 
 namespace hexbite {
 
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string quoted(const std::string& path) {
-  return "'" + path + "'";
-}
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
 
 void require_readable_nonempty(const std::string& path) {
   std::error_code ec;

@@ -35,6 +35,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/paths.h"
 
 namespace hexbite {
 
@@ -46,16 +47,6 @@ const char* const kAcceptedExtensions = ".stl, .obj, .ply, .off, .vtp";
 
 // ------------------------------------------------------------------------------------------------
 // Small helpers shared by the readers.
-
-std::string quoted(const std::string& path) {
-  return "'" + path + "'";
-}
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
 
 void require_known_extension(const std::string& path, const std::string& ext, const char* verb) {
   if (ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".vtp") return;

@@ -1,0 +1,23 @@
+#include "common/paths.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+namespace hexbite {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string quoted(const std::string& path) {
+  return "'" + path + "'";
+}
+
+}  // namespace hexbite
