@@ -111,7 +111,7 @@ void run_reorder(const ReorderOptions& o) {
   } else {
     r = reorder_reverse_cuthill_mckee(mesh);
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = seconds_since(t0);
   write_vtu(o.output, r.mesh, permute_arrays(cell_arrays, r.hex_order),
             permute_arrays(point_arrays, r.node_order));
 

@@ -24,10 +24,6 @@ namespace {
 // faster than setting up the AMG hierarchy, and above it the factorization's fill-in makes CG + AMG win.
 constexpr long long kDirectSolverMaxDofs = 30000;
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 struct Geometry {
   TriSurface surface;
   Landmarks landmarks;

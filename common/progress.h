@@ -6,6 +6,9 @@
 
 namespace hexbite {
 
+// Wall seconds elapsed since t0 (steady clock): the stage timings that reports carry.
+double seconds_since(std::chrono::steady_clock::time_point t0);
+
 // Global verbosity of the command line program; set once from --quiet.
 void set_quiet(bool quiet);
 bool is_quiet();

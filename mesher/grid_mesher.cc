@@ -28,10 +28,6 @@ using vec3::add;
 using vec3::norm;
 using vec3::scale;
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 std::string format_point(const Vec3& p) {
   std::ostringstream s;
   s.precision(1);

@@ -28,10 +28,6 @@ using vec3::add;
 using vec3::norm;
 using vec3::scale;
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // kappa(A)^2 of the corner with columns a, b, c and its gradient with respect to the columns. Returns
 // false (and leaves the outputs alone) when det(A) <= 0.
 //   f = N1 N2 / d^2 with N1 = |A|_F^2, N2 = |adj A|_F^2 = |b x c|^2 + |c x a|^2 + |a x b|^2, d = det A;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "common/progress.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality_kernel.h"
 #include "mesher/surface_projector.h"
@@ -56,10 +57,6 @@ std::array<int, N> lattice_key(const std::array<int, 8>& hex, const LatticePoint
 template <typename Key>
 int find_key(const std::vector<Key>& keys, const Key& key) {
   return static_cast<int>(std::lower_bound(keys.begin(), keys.end(), key) - keys.begin());
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 bool hex_inverted(const HexMesh& mesh, int h) {

@@ -657,7 +657,7 @@ TriSurface clean_surface(const TriSurface& surface, const CleanOptions& options,
     }
     r.volume_before_mm3 = PMP::volume(to_mesh(surface));
     r.volume_after_mm3 = PMP::volume(to_mesh(result));
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.seconds = seconds_since(start);
   }
   return result;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "mesher/hex_block.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_optimize.h"
 #include "mesher/hex_quality.h"
@@ -15,18 +16,7 @@ namespace {
 
 // A structured n x n x n grid of cubes of size h, VTK node order.
 HexMesh make_grid(int n, double h) {
-  HexMesh m;
-  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.vertices.push_back({i * h, j * h, k * h});
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        m.hexes.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                           id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                           id(i, j + 1, k + 1)});
-  return m;
+  return make_block_mesh(n, n, n, {0, 0, 0}, {n * h, n * h, n * h});
 }
 
 bool on_grid_boundary(const Vec3& p, double size) {
