@@ -29,8 +29,9 @@ std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
   const QualitySummary& q = r.quality;
   out << "Meshed " << o.quad_surface << " (cycle elimination, " << elimination_order_name(r.order)
       << "): " << r.quads << " boundary quads, " << r.chords << " chords, " << r.eliminations
-      << " eliminations (" << r.external_sheets << " external sheets), " << r.hexes << " hexes, "
-      << r.interior_vertices << " interior nodes\n";
+      << " eliminations (" << r.eliminations_single << " single, " << r.eliminations_k_step << " k-step; "
+      << r.external_sheets << " external, " << r.internal_sheets << " internal sheets), " << r.hexes
+      << " hexes, " << r.interior_vertices << " interior nodes\n";
   out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
       << q.node_degree.max_edges << "\n";
   out << "interior node degrees (hexes): " << histogram_text(q.node_degree.hexes) << "; maximum "
@@ -75,8 +76,13 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
     j["order"] = elimination_order_name(order);
     j["quads"] = report.quads;
     j["chords"] = report.chords;
-    j["eliminations"] = {{"single", report.eliminations}, {"k_step", 0}};
-    j["sheets"] = {{"external", report.external_sheets}, {"internal", 0}};
+    j["eliminations"] = {{"single", report.eliminations_single}, {"k_step", report.eliminations_k_step}};
+    j["sheets"] = {{"external", report.external_sheets}, {"internal", report.internal_sheets}};
+    j["eliminations_single"] = report.eliminations_single;
+    j["eliminations_k_step"] = report.eliminations_k_step;
+    j["chords_eliminated"] = report.chords_eliminated;
+    j["external_sheets"] = report.external_sheets;
+    j["internal_sheets"] = report.internal_sheets;
     j["hexes"] = report.hexes;
     j["interior_nodes"] = report.interior_vertices;
     j["seconds"] = {{"elimination", report.seconds_elimination}, {"embedding", report.seconds_embedding}};

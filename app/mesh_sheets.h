@@ -7,9 +7,9 @@
 namespace hexbite {
 
 struct MeshSheetsOptions {
-  std::string quad_surface;            // .obj, .vtp or .vtk quad surface of a ball
-  std::string output;                  // .vtu
-  std::string order = "fewest-hexes";  // or look-ahead
+  std::string quad_surface;         // .obj, .vtp or .vtk quad surface of a ball
+  std::string output;               // .vtu
+  std::string order = "geometric";  // or fewest-hexes, look-ahead
   bool json = false;
   bool allow_invalid = false;  // write the mesh even when hexes stay inverted
 };

@@ -3,33 +3,52 @@
 //
 // Input: a QuadSurface that check_quad_surface() finds usable (closed, manifold, consistently oriented
 // outward, genus 0, even, simple, 3-connected, no self-intersecting chord).
-// Algorithm (phase 1: single eliminations with external sheets):
-//   1. Elimination. While the surface is not a cube (6 quads), pick a simple chord and collapse its strip:
-//      every rung (an edge the chord crosses) shrinks to a point, so every strip quad shrinks to an edge and
-//      the two rails of the strip merge. The elimination is feasible when both rails are disjoint simple
-//      cycles (the rung endpoints are 2 L distinct vertices for a chord of length L), the strip separates the
-//      other quads into exactly two sides, and the collapsed surface is again a closed manifold ball whose
-//      graph is simple, planar and 3-connected. The elimination side (the quads that receive hexes) is the
-//      smaller side.
+// Algorithm:
+//   1. Elimination. While the surface is not a cube (6 quads), pick a step and collapse its strips: every
+//      rung (an edge a chord crosses) shrinks to a point, so every strip quad shrinks to an edge and the two
+//      rails of each strip merge. A single elimination takes one simple chord whose rung endpoints are 2 L
+//      distinct vertices (both rails are disjoint simple cycles) and whose strip leaves exactly two sides;
+//      its elimination side Q (the quads that receive hexes) is the smaller side. A k-step elimination takes
+//      k >= 2 chords with pairwise vertex-disjoint strips and the seed's conditions: with Q_i the side of
+//      chord i that holds the other chords and Q their intersection, (2) Q is edge-connected and (3) Q
+//      union Q_i has more quads than Q for every i; also every Q-side rail bounds Q, so that one sheet
+//      under Q meets the surface exactly in the k chords. Either is feasible when (1) the collapsed surface
+//      is again a closed manifold ball whose graph is simple, planar and 3-connected
+//      (is_polyhedral_ball(), mesher/elimination_feasibility.h: a face test, near-linear).
 //   2. Construction, in reverse order, starting from one hex on the final cube: for an elimination with side
-//      A, one hex is placed on each quad of A between the quad as it was before the collapse (outer, on the
-//      larger surface) and as it is after it (inner). The A-side rail vertices map onto their rung partners,
-//      the other vertices of A get new interior vertices; the new sheet of hexes is bounded by the eliminated
-//      chord (an external sheet), whose strip quads become the sheet's side faces.
+//      Q, one hex is placed on each quad of Q between the quad as it was before the collapse (outer, on the
+//      larger surface) and as it is after it (inner). The Q-side rail vertices map onto their rung partners,
+//      the other vertices of Q get new interior vertices; the new sheet of hexes is bounded by the eliminated
+//      chords (an external sheet), whose strip quads become the sheet's side faces.
 //   The boundary of the result is therefore exactly the input surface: vertices 0..n-1 are the input's
 //   vertices with the same coordinates, every input quad is a boundary face, and only interior vertices
 //   (ids >= n) are new.
 //   3. Embedding: new vertices start at the position of the vertex they were split from, then barycentric
 //      smoothing to convergence and optimize_hex_mesh() with every boundary vertex fixed.
-// Ordering strategies: kFewestHexes takes the feasible chord with the smallest elimination side (ties: the
-// lower chord number); kLookAhead takes, in the same order, the first feasible chord after whose elimination
-// the surface is a cube or still has a feasible chord, so that it does not walk into a dead end one step on.
-// Not yet done (phase 2): k-step eliminations of node-disjoint chords, internal sheets, decomposition along a
-// primal cycle, the geometric ordering rule. The Elimination record below keeps the sheet as a list of
-// (outer quad, inner quad) hexes so that those kinds fit in without changing the construction.
-// Failure: when no chord is feasible before the cube, RunError naming the remaining chords.
-// Cost: per step, the chords and sides O(F), a feasibility test O(V (V + E)) (3-connectivity dominates);
-// kFewestHexes usually tests one candidate per step, kLookAhead up to all candidates of the next step.
+// Ordering strategies (single eliminations first try the smallest side; ties: the lower chord number):
+//   kFewestHexes takes the first feasible single elimination; kLookAhead the first after which the surface
+//   is a cube or still has a feasible single elimination (no dead end one step on); kGeometric, the seed's
+//   rule of preferring chords next to sharp primal cycles, puts single and 2-step eliminations whose Q-side
+//   rails are sharp (mean angle between the normals of the strip quads and the Q quads across the rail of
+//   45 degrees or more) before the others, then orders by fewest hexes, with the look-ahead test; 2-steps
+//   only when both rails are sharp. Before all of them come pillows on flat patches (Q, the strip and the
+//   quads across both rails within 15 degrees), whose internal sheet fits only early. The default. The
+//   geometry is that of the current surface: merged rail vertices take their partners' positions, the other
+//   vertices of Q follow by the harmonic extension of those moves.
+// k-steps never rescue a surface on which no single elimination is feasible: the collapse of vertex-
+// disjoint chords is the collapse of one followed by the others, and later collapses neither remove nor
+// separate the quads of a defect made by the first. They change which hexes are built (one annular sheet
+// instead of two disk sheets), which is why only the geometric order weighs them.
+// Internal sheets (mesher/internal_sheet.h) replace external ones during the construction where their
+// conditions hold (SheetMeshOptions::internal_sheets).
+// Not yet done: decomposition along a primal cycle.
+// Failure: when no elimination is feasible before the cube, RunError naming the remaining chords and some of
+// their quads, suggesting --method grid.
+// Cost: per step, the chords and sides O(C F) for C chords and F quads, each feasibility test O(F log F);
+// kFewestHexes usually tests one candidate per step, the look-ahead orders up to all candidates of the next
+// step; the geometric order also measures the rail angles and the flatness of every candidate, O(C F) per
+// step, and prepares the chord pairs whose facing rails are both sharp, O(F) each. The construction tries an
+// internal sheet per elimination, O(m log m) for the m hexes built so far.
 // Deterministic: fixed orders, no hashing, single-threaded.
 #pragma once
 
@@ -43,20 +62,23 @@
 
 namespace hexbite {
 
-enum class EliminationOrder { kFewestHexes, kLookAhead };
+enum class EliminationOrder { kFewestHexes, kLookAhead, kGeometric };
 
-// Parses "fewest-hexes" or "look-ahead"; InputError for anything else.
+// Parses "fewest-hexes", "look-ahead" or "geometric"; InputError for anything else.
 EliminationOrder parse_elimination_order(const std::string& name);
 const char* elimination_order_name(EliminationOrder order);
 
-enum class SheetKind { kExternal };
+enum class SheetKind { kExternal, kInternal };
 
-// One eliminated chord and the sheet of hexes that undoes it.
+// One elimination step (one chord, or k chords at once) and the sheet of hexes that undoes it.
 struct Elimination {
-  SheetKind kind = SheetKind::kExternal;
-  int chord_length = 0;      // quads in the eliminated strip
-  int quads_before = 0;      // surface size before the collapse
-  int other_side_quads = 0;  // quads of the side that got no hexes
+  SheetKind kind = SheetKind::kExternal;  // as eliminated; build_hex_complex() may place an internal one
+  int chords = 1;                         // chords eliminated by this step (k)
+  int chord_length = 0;                   // quads in the eliminated strips
+  int quads_before = 0;                   // surface size before the collapse
+  int other_side_quads = 0;               // quads of the side that got no hexes
+  int first_new_vertex = 0;  // the interior vertices of the inner quads: ids first_new_vertex ...
+  int new_vertices = 0;      // ... first_new_vertex + new_vertices - 1
   // hexes[i] = {outer quad, inner quad}: the outer quad is on the surface before the collapse (counter-
   // clockwise seen from outside), the inner one is the same quad after it, with matching corners.
   std::vector<std::array<std::array<int, 4>, 2>> hexes;
@@ -71,7 +93,9 @@ struct EliminationScheme {
 };
 
 struct EliminationOptions {
-  EliminationOrder order = EliminationOrder::kFewestHexes;
+  // The best measured (docs/sheets.md): equal to the others on blocks, polycubes, box chains and spheres,
+  // as good on the jaw's quad surface, valid where they leave inverted hexes (the O-grid disk).
+  EliminationOrder order = EliminationOrder::kGeometric;
 };
 
 // Step 1. Throws InputError when the surface is not usable and RunError when no feasible chord is left.
@@ -81,8 +105,18 @@ EliminationScheme eliminate_chords(const QuadSurface& surface, const Elimination
 // interior ones placed at the vertex they were split from (not yet embedded).
 HexMesh build_hex_complex(const QuadSurface& surface, const EliminationScheme& scheme);
 
+// The same, placing an internal sheet (mesher/internal_sheet.h) instead of the external one wherever its
+// conditions hold when internal_sheets is set; kinds (if not null) receives the kind of every elimination's
+// sheet, in elimination order. Vertices no hex uses any more (the created vertices of an internal sheet's
+// side, which take back the outer quads' ids) are dropped, the others keep their order.
+HexMesh build_hex_complex(const QuadSurface& surface, const EliminationScheme& scheme, bool internal_sheets,
+                          std::vector<SheetKind>* kinds);
+
 struct SheetMeshOptions {
   EliminationOptions elimination;
+  // Internal sheets where their conditions hold (build_hex_complex); never worse in the measured cases,
+  // valid where the external sheet is flat (a pillowed patch of a face, docs/sheets.md).
+  bool internal_sheets = true;
   int smoothing_iterations = 500;  // barycentric sweeps before the optimizer
   bool optimize = true;
   OptimizeOptions optimizer;
@@ -90,12 +124,16 @@ struct SheetMeshOptions {
 
 struct SheetMeshReport {
   int quads = 0;
-  int chords = 0;  // chords of the input surface
-  int eliminations = 0;
+  int chords = 0;               // chords of the input surface
+  int eliminations = 0;         // steps
+  int eliminations_single = 0;  // steps of one chord
+  int eliminations_k_step = 0;  // steps of k >= 2 chords
+  int chords_eliminated = 0;    // chords - 3 for a complete scheme
   int external_sheets = 0;
+  int internal_sheets = 0;
   int hexes = 0;
   int interior_vertices = 0;
-  EliminationOrder order = EliminationOrder::kFewestHexes;
+  EliminationOrder order = EliminationOrder::kGeometric;
   double seconds_elimination = 0.0;
   double seconds_embedding = 0.0;
   OptimizeReport optimize;  // empty phases when optimization is off

@@ -1,5 +1,6 @@
-// Quad surfaces for the quad check and cycle elimination suites: block and polycube boundaries, perturbed
-// copies, a torus, and a ball with a self-intersecting chord.
+// Quad surfaces for the quad check and cycle elimination suites and the sheet mesher's benchmark: block and
+// polycube boundaries, a box chain, a cubed sphere, an O-grid disk, perturbed copies, a torus, a ball with a
+// self-intersecting chord and a ball without any elimination scheme.
 #pragma once
 
 #include <algorithm>
@@ -29,6 +30,94 @@ inline QuadSurface polycube_surface(int nx, int ny, int nz, const std::function<
 
 inline QuadSurface block_surface(int nx, int ny, int nz) {
   return polycube_surface(nx, ny, nz, [](int, int, int) { return true; });
+}
+
+// A quad ball: the boundary of an n x n x n block centred at the origin, every vertex pushed onto the sphere
+// of radius `radius` (6 n^2 quads, 3 n chords of length 4 n).
+inline QuadSurface sphere_surface(int n, double radius = 1.0) {
+  QuadSurface s = block_surface(n, n, n);
+  for (Vec3& p : s.vertices) {
+    double norm = 0.0;
+    for (double& c : p) {
+      c -= 0.5 * n;
+      norm += c * c;
+    }
+    for (double& c : p) c *= radius / std::sqrt(norm);
+  }
+  return s;
+}
+
+// A chain of boxes turning twice: a Z in the xy plane made of four r x r x 2r boxes (cells (0,0), (1,0),
+// (1,1), (2,1) of a 3 x 2 layout), every box a block of unit cubes.
+inline QuadSurface box_chain_surface(int r) {
+  return polycube_surface(3 * r, 2 * r, 2 * r, [r](int i, int j, int) {
+    const int bi = i / r, bj = j / r;
+    return (bj == 0 && bi <= 1) || (bj == 1 && bi >= 1);
+  });
+}
+
+// A disk of radius 2 and height 1 with O-grid caps: each cap a 2 x 2 grid of unit quads surrounded by a ring
+// of 8 quads out to an 8-gon rim, the side wall one ring of 8 quads (24 quads, 7 chords: the two cap rings,
+// the wall ring and 4 chords through both caps). The region between the cap rings (the wall) is bounded by
+// the two sharp rims: the annular sheet of a 2-step elimination.
+inline QuadSurface o_grid_disk_surface() {
+  QuadSurface s;
+  const double pi = 3.141592653589793;
+  // Per cap (z = 0, 1): the 3 x 3 grid points (id = 9 level + 3 (y + 1) + (x + 1)), then the rims.
+  for (int level = 0; level < 2; ++level)
+    for (int y = -1; y <= 1; ++y)
+      for (int x = -1; x <= 1; ++x) s.vertices.push_back({double(x), double(y), double(level)});
+  for (int level = 0; level < 2; ++level)
+    for (int i = 0; i < 8; ++i)
+      s.vertices.push_back({2.0 * std::cos(i * pi / 4), 2.0 * std::sin(i * pi / 4), double(level)});
+  auto grid = [](int level, int x, int y) { return 9 * level + 3 * (y + 1) + (x + 1); };
+  auto rim = [](int level, int i) { return 18 + 8 * level + (i % 8); };
+  // The grid's boundary loop, counter-clockwise seen from +z, at the rim's angles.
+  const int loop[8][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+  for (int level = 0; level < 2; ++level) {
+    std::vector<std::array<int, 4>> cap;
+    for (int y = -1; y < 1; ++y)
+      for (int x = -1; x < 1; ++x)
+        cap.push_back(
+            {grid(level, x, y), grid(level, x + 1, y), grid(level, x + 1, y + 1), grid(level, x, y + 1)});
+    for (int i = 0; i < 8; ++i) {
+      const int j = (i + 1) % 8;
+      cap.push_back({grid(level, loop[i][0], loop[i][1]), rim(level, i), rim(level, j),
+                     grid(level, loop[j][0], loop[j][1])});
+    }
+    // Counter-clockwise seen from outside: from +z on top, from -z on the bottom.
+    for (auto q : cap) {
+      if (level == 0) std::reverse(q.begin(), q.end());
+      s.quads.push_back(q);
+    }
+  }
+  for (int i = 0; i < 8; ++i) s.quads.push_back({rim(0, i), rim(0, i + 1), rim(1, i + 1), rim(1, i)});
+  return s;
+}
+
+// The 3 x 3 x 3 block with its top centre quad pillowed: the quad replaced by a quad shrunk to half its
+// size around its centre, joined to the old corners by a ring of 4 quads (58 quads, 10 chords: the ring
+// is a chord of length 4 whose smaller side is the shrunk quad, in the plane of the top face).
+inline QuadSurface pillowed_block_surface() {
+  QuadSurface s = block_surface(3, 3, 3);
+  for (std::size_t q = 0; q < s.quads.size(); ++q) {
+    const auto quad = s.quads[q];
+    Vec3 centre{0.0, 0.0, 0.0};
+    for (int v : quad)
+      for (int c = 0; c < 3; ++c) centre[c] += 0.25 * s.vertices[v][c];
+    if (centre[0] != 1.5 || centre[1] != 1.5 || centre[2] != 3.0) continue;
+    std::array<int, 4> inner{};
+    for (int k = 0; k < 4; ++k) {
+      inner[k] = static_cast<int>(s.vertices.size());
+      Vec3 p = s.vertices[quad[k]];
+      for (int c = 0; c < 3; ++c) p[c] = 0.5 * (p[c] + centre[c]);
+      s.vertices.push_back(p);
+    }
+    s.quads[q] = inner;
+    for (int k = 0; k < 4; ++k) s.quads.push_back({quad[k], quad[(k + 1) % 4], inner[(k + 1) % 4], inner[k]});
+    break;
+  }
+  return s;
 }
 
 // Moves every vertex by a deterministic pseudo-random offset of at most `amplitude` per coordinate.
@@ -87,6 +176,17 @@ inline QuadSurface self_intersecting_surface() {
   QuadSurface s = block_surface(2, 2, 2);
   collapse_diagonal(s, {1, 1, 2}, {2, 2, 2});
   collapse_diagonal(s, {1, 1, 0}, {2, 0, 0});
+  return s;
+}
+
+// A ball (30 quads, 6 simple chords, 3-connected) without any elimination scheme: the 3 x 2 x 2 block with
+// the top and the bottom quad over the cell [1, 2] x [1, 2] collapsed along crossing diagonals. Every
+// feasible first elimination leaves a surface with no feasible one (found by a search over diagonal
+// collapses of small blocks).
+inline QuadSurface no_scheme_surface() {
+  QuadSurface s = block_surface(3, 2, 2);
+  collapse_diagonal(s, {1, 2, 2}, {2, 1, 2});
+  collapse_diagonal(s, {2, 2, 0}, {1, 1, 0});
   return s;
 }
 

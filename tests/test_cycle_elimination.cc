@@ -3,9 +3,11 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <numeric>
 
 #include "common/error.h"
 #include "mesher/cycle_elimination.h"
+#include "mesher/elimination_feasibility.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/quad_check.h"
@@ -48,9 +50,10 @@ TEST(CycleElimination, CubeIsOneHex) {
   expect_boundary_equals_input(mesh, s);
 }
 
-// Each elimination removes exactly one chord, so a perfect scheme has chords - 3 steps. On a block the
-// smallest side is always an end face, so fewest-hexes peels off end slabs and rebuilds the n m k grid,
-// which barycentric smoothing places exactly.
+// A single elimination removes exactly one chord, so a perfect scheme of single steps has chords - 3 steps.
+// On a block the smallest side is always an end face, next to the block's right-angled edges, so the
+// default (geometric) order, like fewest-hexes, peels off end slabs and rebuilds the n m k grid, which
+// barycentric smoothing places exactly.
 TEST(CycleElimination, BlocksGiveTheStructuredGrid) {
   for (const std::array<int, 3> dims : {std::array<int, 3>{2, 1, 1}, {2, 2, 2}, {3, 2, 1}, {3, 3, 4}}) {
     const auto [n, m, k] = dims;
@@ -72,16 +75,20 @@ TEST(CycleElimination, BlocksGiveTheStructuredGrid) {
   }
 }
 
-void expect_valid_sheet_mesh(const QuadSurface& s, EliminationOrder order) {
+SheetMeshReport expect_valid_sheet_mesh(const QuadSurface& s, EliminationOrder order) {
   SheetMeshOptions options;
   options.elimination.order = order;
   SheetMeshReport report;
   const HexMesh mesh = mesh_by_cycle_elimination(s, options, &report);
-  EXPECT_EQ(report.eliminations, chord_count(s) - 3);
+  EXPECT_EQ(report.chords_eliminated, chord_count(s) - 3);
+  EXPECT_EQ(report.eliminations, report.eliminations_single + report.eliminations_k_step);
+  EXPECT_EQ(report.chords_eliminated, report.eliminations_single + 2 * report.eliminations_k_step);
+  EXPECT_EQ(report.external_sheets + report.internal_sheets, report.eliminations);
   EXPECT_EQ(report.quality.inverted, 0);
   EXPECT_GT(report.quality.scaled_jacobian.min, 0.0);
   EXPECT_EQ(report.hexes, static_cast<int>(mesh.hexes.size()));
   expect_boundary_equals_input(mesh, s);
+  return report;
 }
 
 TEST(CycleElimination, PerturbedBlock) {
@@ -89,7 +96,7 @@ TEST(CycleElimination, PerturbedBlock) {
                           EliminationOrder::kFewestHexes);
 }
 
-TEST(CycleElimination, PolycubesBothOrders) {
+TEST(CycleElimination, PolycubesAllOrders) {
   const QuadSurface l = test::polycube_surface(2, 2, 1, [](int i, int j, int) { return i == 0 || j == 0; });
   // A chain of boxes turning twice (a Z in the xy plane, two cells thick).
   const QuadSurface z = test::polycube_surface(
@@ -98,11 +105,216 @@ TEST(CycleElimination, PolycubesBothOrders) {
   const QuadSurface thick_l =
       test::polycube_surface(3, 3, 2, [](int i, int j, int) { return i == 0 || j == 0; });
   for (const QuadSurface* s : {&l, &z, &thick_l})
-    for (EliminationOrder order : {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead}) {
+    for (EliminationOrder order :
+         {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
       SCOPED_TRACE(std::string(elimination_order_name(order)) + ", " + std::to_string(s->quads.size()) +
                    " quads");
       expect_valid_sheet_mesh(test::perturbed(*s, 0.05), order);
     }
+}
+
+// The collapse of a chord as a graph operation, whichever side moves: the strip quads vanish and the two
+// ends of every rung become one vertex (the smaller id). Empty when two rungs share an endpoint.
+std::vector<std::array<int, 4>> contract_chord(const std::vector<std::array<int, 4>>& quads, const Chord& c) {
+  const QuadEdges qe = build_quad_edges(quads);
+  int n = 0;
+  for (const auto& q : quads) n = std::max(n, *std::max_element(q.begin(), q.end()) + 1);
+  std::vector<int> to(static_cast<std::size_t>(n));
+  std::iota(to.begin(), to.end(), 0);
+  std::vector<char> used(static_cast<std::size_t>(n), 0), strip(quads.size(), 0);
+  for (int e : c.edges) {
+    const auto [a, b] = qe.edges[e];
+    if (used[a]++ || used[b]++) return {};
+    to[b] = a;
+  }
+  for (int q : c.quads) strip[q] = 1;
+  std::vector<std::array<int, 4>> out;
+  for (std::size_t q = 0; q < quads.size(); ++q) {
+    if (strip[q]) continue;
+    auto m = quads[q];
+    for (int& v : m) v = to[v];
+    out.push_back(m);
+  }
+  return out;
+}
+
+// The near-linear face test must agree with the full check (removal of every vertex for 3-connectivity,
+// Boyer-Myrvold for planarity) on every chord collapse of several surfaces, two levels deep, feasible or
+// not.
+TEST(CycleElimination, FaceTestAgreesWithFullCheck) {
+  const std::vector<QuadSurface> surfaces = {
+      test::block_surface(3, 2, 2),
+      test::block_surface(3, 3, 1),  // its rim chord leaves vertices of degree 2
+      test::polycube_surface(3, 3, 2, [](int i, int j, int) { return i == 0 || j == 0; }),
+      test::polycube_surface(3, 2, 2,
+                             [](int i, int j, int) { return (j == 0 && i <= 1) || (j == 1 && i >= 1); }),
+      test::o_grid_disk_surface(),
+      test::no_scheme_surface(),
+      test::sphere_surface(3)};
+  int feasible = 0, infeasible = 0;
+  auto compare = [&](const std::vector<std::array<int, 4>>& quads, int vertices) {
+    QuadSurface q;
+    q.vertices.assign(static_cast<std::size_t>(vertices), Vec3{0.0, 0.0, 0.0});
+    q.quads = quads;
+    const QuadSurfaceReport r = check_quad_surface(q, "");
+    const bool full = r.ball && r.simple && r.planar && r.three_connected;
+    EXPECT_EQ(is_polyhedral_ball(quads), full) << quads.size() << " quads";
+    (full ? feasible : infeasible) += 1;
+    return full;
+  };
+  for (const QuadSurface& s : surfaces) {
+    const int n = static_cast<int>(s.vertices.size());
+    EXPECT_TRUE(compare(s.quads, n));
+    for (const Chord& c : find_chords(s.quads, build_quad_edges(s.quads))) {
+      if (!c.simple()) continue;
+      const auto once = contract_chord(s.quads, c);
+      if (once.empty() || !compare(once, n)) continue;
+      for (const Chord& d : find_chords(once, build_quad_edges(once))) {
+        if (!d.simple()) continue;
+        const auto twice = contract_chord(once, d);
+        if (!twice.empty()) compare(twice, n);
+      }
+    }
+  }
+  EXPECT_GT(feasible, 50);
+  EXPECT_GT(infeasible, 10);
+}
+
+// The O-grid disk's wall lies between two sharp rims: the geometric order eliminates both cap rings at once
+// (a 2-step with Q = the 8 wall quads, one annular sheet), then the remaining 2 x 2 x 1 block by single
+// eliminations: the 12 hexes of the O-grid, with no interior vertex and no inverted hex (fewest-hexes leaves
+// 8 inverted, docs/sheets.md).
+TEST(CycleElimination, GeometricOrderTakesTheAnnularSheetOfAnOGridDisk) {
+  const QuadSurface s = test::o_grid_disk_surface();
+  ASSERT_TRUE(check_quad_surface(s, "").usable());
+  ASSERT_EQ(chord_count(s), 7);
+  EliminationOptions options;
+  options.order = EliminationOrder::kGeometric;
+  const EliminationScheme scheme = eliminate_chords(s, options);
+  ASSERT_FALSE(scheme.eliminations.empty());
+  EXPECT_EQ(scheme.eliminations[0].chords, 2);
+  EXPECT_EQ(scheme.eliminations[0].hexes.size(), 8u);
+  EXPECT_EQ(scheme.eliminations[0].chord_length, 16);
+  const SheetMeshReport geometric = expect_valid_sheet_mesh(s, EliminationOrder::kGeometric);
+  EXPECT_EQ(geometric.eliminations_k_step, 1);
+  EXPECT_EQ(geometric.eliminations_single, 2);
+  EXPECT_EQ(geometric.hexes, 12);
+  EXPECT_EQ(geometric.interior_vertices, 0);
+  // Fewest-hexes (single eliminations only) first puts 4 hexes on a cap's 2 x 2 centre, whose rail then
+  // merges into the rim in the same plane; with every vertex on the boundary nothing can repair that.
+  SheetMeshOptions fewest_hexes;
+  fewest_hexes.elimination.order = EliminationOrder::kFewestHexes;
+  SheetMeshReport fewest;
+  mesh_by_cycle_elimination(s, fewest_hexes, &fewest);
+  EXPECT_EQ(fewest.eliminations_k_step, 0);
+  EXPECT_EQ(fewest.eliminations_single, 4);
+  EXPECT_GT(fewest.quality.inverted, 0);
+  EXPECT_GT(geometric.quality.scaled_jacobian.min, fewest.quality.scaled_jacobian.min);
+}
+
+// The pillowed block's ring chord has the shrunk quad as its smaller side, in the plane of the top face:
+// an external sheet there is one flat hex whose 8 vertices are all on the boundary. The internal sheet
+// instead wraps the block's top centre hex in 5 hexes (its 4 lower corners duplicated inside), so that
+// fewest-hexes and the geometric order give 27 + 5 hexes, one internal sheet and no inverted hex; without
+// internal sheets the flat hex stays.
+TEST(CycleElimination, InternalSheetUnderAPillowedPatch) {
+  const QuadSurface s = test::pillowed_block_surface();
+  ASSERT_TRUE(check_quad_surface(s, "").usable());
+  EXPECT_EQ(s.quads.size(), 58u);
+  EXPECT_EQ(chord_count(s), 10);
+  const SheetMeshReport internal = expect_valid_sheet_mesh(s, EliminationOrder::kFewestHexes);
+  EXPECT_EQ(internal.internal_sheets, 1);
+  EXPECT_EQ(internal.external_sheets, 6);
+  EXPECT_EQ(internal.hexes, 32);
+  EXPECT_EQ(internal.interior_vertices, 8 + 4);
+  // The default order takes the flat pillow first too, while the hex below it is still interior.
+  const SheetMeshReport by_default = expect_valid_sheet_mesh(s, EliminationOrder::kGeometric);
+  EXPECT_EQ(by_default.internal_sheets, 1);
+  EXPECT_EQ(by_default.hexes, 32);
+
+  SheetMeshOptions external_only;
+  external_only.elimination.order = EliminationOrder::kFewestHexes;
+  external_only.internal_sheets = false;
+  SheetMeshReport external;
+  const HexMesh mesh = mesh_by_cycle_elimination(s, external_only, &external);
+  expect_boundary_equals_input(mesh, s);
+  EXPECT_EQ(external.internal_sheets, 0);
+  EXPECT_EQ(external.hexes, 28);
+  EXPECT_EQ(external.quality.inverted, 1);
+
+  // The two-argument construction is the external one; the overload reports the kinds in elimination
+  // order (the ring, eliminated first, got the internal sheet).
+  EliminationOptions fewest;
+  fewest.order = EliminationOrder::kFewestHexes;
+  const EliminationScheme scheme = eliminate_chords(s, fewest);
+  EXPECT_EQ(build_hex_complex(s, scheme).hexes.size(), 28u);
+  std::vector<SheetKind> kinds;
+  EXPECT_EQ(build_hex_complex(s, scheme, true, &kinds).hexes.size(), 32u);
+  ASSERT_EQ(kinds.size(), scheme.eliminations.size());
+  EXPECT_EQ(kinds[0], SheetKind::kInternal);
+  EXPECT_EQ(std::count(kinds.begin(), kinds.end(), SheetKind::kInternal), 1);
+}
+
+TEST(CycleElimination, NoSchemeIsARunErrorNamingTheChords) {
+  const QuadSurface s = test::no_scheme_surface();
+  ASSERT_TRUE(check_quad_surface(s, "").usable());
+  EXPECT_EQ(s.quads.size(), 30u);
+  for (EliminationOrder order :
+       {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
+    SCOPED_TRACE(elimination_order_name(order));
+    EliminationOptions options;
+    options.order = order;
+    try {
+      eliminate_chords(s, options);
+      ADD_FAILURE() << "no RunError";
+    } catch (const RunError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("cycle elimination is stuck"), std::string::npos) << m;
+      EXPECT_NE(m.find("chord 0 (length"), std::string::npos) << m;
+      EXPECT_NE(m.find("--method grid"), std::string::npos) << m;
+      // The look-ahead orders see at once that every feasible first step is a dead end.
+      if (order != EliminationOrder::kFewestHexes)
+        EXPECT_NE(m.find("after 0 eliminations"), std::string::npos);
+    }
+  }
+}
+
+// Many generated balls: every usable polycube of a 3 x 3 x 2 cell block (cell subsets from a fixed
+// pseudo-random sequence) in every order, with internal sheets. The complex must be conforming, every hex
+// must have 8 distinct vertices, and its boundary must be the input exactly; a complete scheme eliminates
+// all chords but three.
+TEST(CycleElimination, ManyGeneratedPolycubes) {
+  unsigned state = 7u;
+  int tested = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    state = state * 1664525u + 1013904223u;
+    const unsigned mask = state >> 5;
+    auto keep = [mask](int i, int j, int k) { return ((mask >> (i + 3 * j + 9 * k)) & 1u) != 0; };
+    int cells = 0;
+    for (int c = 0; c < 18; ++c) cells += (mask >> c) & 1u;
+    if (cells < 2) continue;
+    const QuadSurface s = test::polycube_surface(3, 3, 2, keep);
+    if (!check_quad_surface(s, "").usable()) continue;
+    ++tested;
+    for (EliminationOrder order :
+         {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
+      SCOPED_TRACE("cells " + std::to_string(mask & 0x3ffffu) + ", " + elimination_order_name(order));
+      EliminationOptions options;
+      options.order = order;
+      const EliminationScheme scheme = eliminate_chords(s, options);
+      int removed = 0;
+      for (const Elimination& e : scheme.eliminations) removed += e.chords;
+      EXPECT_EQ(removed, chord_count(s) - 3);
+      const HexMesh mesh = build_hex_complex(s, scheme, true, nullptr);
+      for (const auto& hex : mesh.hexes) {
+        auto sorted = hex;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+      }
+      expect_boundary_equals_input(mesh, s);
+    }
+  }
+  EXPECT_GT(tested, 200);
 }
 
 TEST(CycleElimination, SameBytesTwice) {
@@ -128,6 +340,7 @@ TEST(CycleElimination, RejectsUnusableSurfaces) {
   EXPECT_NE(input_error(test::self_intersecting_surface()).find("self-intersects"), std::string::npos);
   EXPECT_THROW(parse_elimination_order("random"), InputError);
   EXPECT_EQ(parse_elimination_order("look-ahead"), EliminationOrder::kLookAhead);
+  EXPECT_EQ(parse_elimination_order("geometric"), EliminationOrder::kGeometric);
 }
 
 }  // namespace
@@ -147,6 +360,11 @@ TEST(MeshSheetsCli, WritesTheMeshAndRejectsBadSurfaces) {
   EXPECT_EQ(j["hexes"], 12);
   EXPECT_EQ(j["chords"], 7);
   EXPECT_EQ(j["quality"]["inverted"], 0);
+  EXPECT_EQ(j["eliminations_single"], 4);
+  EXPECT_EQ(j["eliminations_k_step"], 0);
+  EXPECT_EQ(j["external_sheets"], 4);
+  EXPECT_EQ(j["internal_sheets"], 0);
+  EXPECT_EQ(j["eliminations"]["single"], 4);
   const HexMesh mesh = read_vtu(dir + "/m.vtu");
   EXPECT_EQ(mesh.hexes.size(), 12u);
   for (std::size_t v = 0; v < s.vertices.size(); ++v) EXPECT_EQ(mesh.vertices[v], s.vertices[v]);
@@ -157,6 +375,15 @@ TEST(MeshSheetsCli, WritesTheMeshAndRejectsBadSurfaces) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("not a ball: genus 1"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/t.vtu"));
+
+  write_quad_obj(dir + "/stuck.obj", test::no_scheme_surface());
+  const auto stuck = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/stuck.obj",
+                                        "--order", "look-ahead", "-o", dir + "/s.vtu"});
+  EXPECT_EQ(stuck.exit_code, 1);
+  EXPECT_NE(stuck.err.find("stuck after 0 eliminations"), std::string::npos) << stuck.err;
+  EXPECT_NE(stuck.err.find("chord 0 (length"), std::string::npos) << stuck.err;
+  EXPECT_NE(stuck.err.find("--method grid"), std::string::npos) << stuck.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/s.vtu"));
 }
 
 }  // namespace
