@@ -1,5 +1,8 @@
 // hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--json]
 // [--allow-invalid]
+// hexbite mesh SURFACE --method sheets [--landmarks L.yaml] --target-hexes N -o mesh.vtu (a mandible:
+// app/mesh_sheets_surface.h) or hexbite mesh --method sheets --quad-surface Q.obj -o mesh.vtu
+// (app/mesh_sheets.h)
 //
 // Meshes a closed triangulated solid with hexahedra (overlay grid + pillow layer + optimization) and prints
 // the quality per phase (like the seed paper's Table 1), the timings and the geometric fidelity. A mesh
@@ -14,6 +17,7 @@
 
 #include "app/commands.h"
 #include "app/mesh_sheets.h"
+#include "app/mesh_sheets_surface.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/grid_mesher.h"
@@ -38,8 +42,9 @@ struct MeshOptions {
   bool json = false;
   bool allow_invalid = false;
   double margin = GridMeshOptions{}.margin;
-  std::string quad_surface;            // --method sheets
-  std::string order = "fewest-hexes";  // --method sheets
+  std::string quad_surface;         // --method sheets
+  std::string order = "geometric";  // --method sheets
+  std::string landmarks;            // --method sheets on a SURFACE
 };
 
 std::string fmt(const char* format, double v) {
@@ -167,6 +172,9 @@ std::string inverted_list(const HexMesh& mesh, const std::vector<int>& inverted)
 }
 
 void run_mesh(const MeshOptions& o) {
+  if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
+    return run_mesh_sheets_surface(
+        {{o.surface, o.landmarks, o.units, 0, o.output, o.json}, o.target, o.order, o.allow_invalid});
   if (o.method == "sheets")
     return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
@@ -208,14 +216,21 @@ void run_mesh(const MeshOptions& o) {
 void add_mesh_command(CLI::App& app) {
   auto o = std::make_shared<MeshOptions>();
   CLI::App* cmd = app.add_subcommand("mesh", "Mesh a closed triangulated solid with hexahedra");
-  cmd->add_option("surface", o->surface, "Closed surface (.stl .obj .ply .off .vtp); for --method grid");
+  cmd->add_option(
+      "surface", o->surface,
+      "Closed surface (.stl .obj .ply .off .vtp); for --method grid, or a mandible for --method sheets");
   cmd->add_option("--quad-surface", o->quad_surface,
                   "Quad surface of a ball (.obj .vtp .vtk), for --method sheets");
-  cmd->add_option("--order", o->order, "Elimination order for --method sheets: fewest-hexes or look-ahead")
+  cmd->add_option(
+      "--landmarks", o->landmarks,
+      "Landmark file (.yaml) of the SURFACE, placing the mandible quad template for --method sheets");
+  cmd->add_option("--order", o->order,
+                  "Elimination order for --method sheets: geometric, fewest-hexes or look-ahead")
       ->capture_default_str();
   cmd->add_option(
          "--method", o->method,
-         "Meshing method: grid (overlay grid + pillow layer) or sheets (cycle elimination of --quad-surface)")
+         "Meshing method: grid (overlay grid + pillow layer) or sheets (cycle elimination of --quad-surface, "
+         "or of the mandible quad template placed on the SURFACE)")
       ->check(CLI::IsMember({"grid", "sheets"}));
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")->default_val(2500);
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required();

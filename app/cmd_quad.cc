@@ -1,4 +1,5 @@
 // hexbite quad check Q.obj [--json]
+// hexbite quad from-mandible SURFACE [--landmarks L.yaml] [--target-quads N] -o Q.obj [--json]
 //
 // Reports what the sheet mesher (hexbite mesh --method sheets) needs to know about a quad surface: closed,
 // manifold, genus, even quad count, simple, planar and 3-connected graph, the chords with their lengths and
@@ -12,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_sheets_surface.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/quad_check.h"
@@ -143,6 +145,23 @@ void add_quad_commands(CLI::App& app) {
       ->required();
   cmd->add_flag("--json", options->json, "Print the report as one JSON object on standard output");
   cmd->callback([options] { run_quad_check(*options); });
+
+  auto from = std::make_shared<MandibleQuadCommandOptions>();
+  CLI::App* fm = quad->add_subcommand(
+      "from-mandible",
+      "Quad surface of a triangulated mandible: macro-element template placed by landmarks, refined keeping "
+      "every chord simple, nodes on the surface");
+  fm->add_option("SURFACE", from->surface, "Closed mandible surface (.stl .obj .ply .off .vtp)")->required();
+  fm->add_option(
+      "--landmarks", from->landmarks,
+      "Landmark file (.yaml) in the surface's frame; without it extreme points place the template");
+  fm->add_option("--target-quads", from->target_quads, "Wanted number of quads (24 to 200,000)")
+      ->default_val(1300);
+  fm->add_option("--units", from->units, "Length unit of the surface and landmark files: mm, cm or m")
+      ->default_val("mm");
+  fm->add_option("-o,--output", from->output, "Output quad surface (.obj)")->required();
+  fm->add_flag("--json", from->json, "Print the report as one JSON object on standard output");
+  fm->callback([from] { run_quad_from_mandible(*from); });
 }
 
 }  // namespace hexbite

@@ -1,0 +1,723 @@
+#include "mesher/quad_surface_placement.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include "common/error.h"
+#include "common/progress.h"
+#include "mesher/mandible_quad_template.h"
+#include "mesher/quad_check.h"
+#include "mesher/surface_projector.h"
+#include "mesher/thin_plate_spline.h"
+#include "mesher/vec3.h"
+
+namespace hexbite {
+
+using vec3::add;
+using vec3::cross;
+using vec3::dot;
+using vec3::norm;
+using vec3::scale;
+using vec3::sub;
+
+namespace {
+
+constexpr double kMinNormalAgreement = 0.2;
+
+Vec3 unit(const Vec3& a) {
+  const double n = norm(a);
+  return n > 0 ? scale(a, 1.0 / n) : Vec3{0, 0, 0};
+}
+
+// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return add(a, scale(ab, d1 / (d1 - d3)));
+  const Vec3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return add(a, scale(ac, d2 / (d2 - d6)));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+  const double denom = 1.0 / (va + vb + vc);
+  return add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)));
+}
+
+// Closest surface point among the triangles whose outward normal agrees with a given direction: the
+// multi-patch restriction that keeps a node on its own side of a thin plate. A uniform grid of triangle
+// bounding boxes, searched in growing rings until no closer triangle can remain.
+class OrientedProjector {
+ public:
+  explicit OrientedProjector(const TriSurface& s) : s_(s) {
+    lo_ = {1e300, 1e300, 1e300};
+    Vec3 hi{-1e300, -1e300, -1e300};
+    for (const Vec3& v : s.vertices)
+      for (int a = 0; a < 3; ++a) {
+        lo_[a] = std::min(lo_[a], v[a]);
+        hi[a] = std::max(hi[a], v[a]);
+      }
+    for (int a = 0; a < 3; ++a) {
+      lo_[a] -= kMargin;
+      dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] + kMargin - lo_[a]) / kCell)));
+    }
+    cells_.resize(static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2]);
+    normals_.resize(s.triangles.size());
+    for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+      const Vec3 &a = s.vertices[s.triangles[t][0]], &b = s.vertices[s.triangles[t][1]],
+                 &c = s.vertices[s.triangles[t][2]];
+      normals_[t] = unit(cross(sub(b, a), sub(c, a)));
+      std::array<int, 3> i0, i1;
+      for (int k = 0; k < 3; ++k) {
+        i0[k] = cell_index(std::min({a[k], b[k], c[k]}), k);
+        i1[k] = cell_index(std::max({a[k], b[k], c[k]}), k);
+      }
+      for (int z = i0[2]; z <= i1[2]; ++z)
+        for (int y = i0[1]; y <= i1[1]; ++y)
+          for (int x = i0[0]; x <= i1[0]; ++x) cells_[flat(x, y, z)].push_back(static_cast<int>(t));
+    }
+  }
+
+  // Closest point on a triangle with normal . direction > kMinNormalAgreement and normal . previous > 0
+  // (previous: the normal where the node sat before this move, or zero; it keeps a node whose quad-mesh
+  // normal points along a thin rim from crossing over to the rim's other face). triangle = -1 when no such
+  // triangle lies within the search range.
+  SurfacePoint closest(const Vec3& p, const Vec3& direction, const Vec3& previous) const {
+    std::array<int, 3> c;
+    double outside = 0;  // distance from p to the grid box
+    for (int k = 0; k < 3; ++k) {
+      c[k] = cell_index(p[k], k);
+      const double lo = lo_[k], hi = lo_[k] + dims_[k] * kCell;
+      const double d = std::max({lo - p[k], p[k] - hi, 0.0});
+      outside += d * d;
+    }
+    outside = std::sqrt(outside);
+    double best = std::numeric_limits<double>::infinity();
+    SurfacePoint best_point;
+    const int max_ring = std::max({dims_[0], dims_[1], dims_[2]});
+    for (int r = 0; r <= max_ring; ++r) {
+      if (best <= (r - 1) * kCell - outside) break;  // every unvisited cell is farther than best
+      if (r * kCell - outside > kSearchRange) break;
+      for (int z = c[2] - r; z <= c[2] + r; ++z)
+        for (int y = c[1] - r; y <= c[1] + r; ++y)
+          for (int x = c[0] - r; x <= c[0] + r; ++x) {
+            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;
+            if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2]) continue;
+            for (int t : cells_[flat(x, y, z)]) {
+              if (dot(normals_[t], direction) <= kMinNormalAgreement || dot(normals_[t], previous) < 0)
+                continue;
+              const auto& tri = s_.triangles[t];
+              const Vec3 q =
+                  closest_on_triangle(p, s_.vertices[tri[0]], s_.vertices[tri[1]], s_.vertices[tri[2]]);
+              const double d = norm(sub(q, p));
+              if (d < best) {
+                best = d;
+                best_point = {q, normals_[t], t, d};
+              }
+            }
+          }
+    }
+    if (!std::isfinite(best)) return SurfacePoint{};
+    return best_point;
+  }
+
+ private:
+  static constexpr double kCell = 3.0;
+  static constexpr double kMargin = 1.0;
+  static constexpr double kSearchRange = 25.0;
+  int cell_index(double v, int axis) const {
+    return std::clamp(static_cast<int>(std::floor((v - lo_[axis]) / kCell)), 0, dims_[axis] - 1);
+  }
+  std::size_t flat(int x, int y, int z) const {
+    return (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x;
+  }
+  const TriSurface& s_;
+  Vec3 lo_{};
+  std::array<int, 3> dims_{};
+  std::vector<std::vector<int>> cells_;
+  std::vector<Vec3> normals_;
+};
+
+// Nearest point of a fixed point set (the quad nodes of one relaxation sweep) among those a predicate
+// accepts: a uniform grid searched in growing rings.
+class PointGrid {
+ public:
+  PointGrid(const std::vector<Vec3>& points, double cell) : points_(points), cell_(cell) {
+    lo_ = {1e300, 1e300, 1e300};
+    Vec3 hi{-1e300, -1e300, -1e300};
+    for (const Vec3& p : points)
+      for (int a = 0; a < 3; ++a) {
+        lo_[a] = std::min(lo_[a], p[a]);
+        hi[a] = std::max(hi[a], p[a]);
+      }
+    for (int a = 0; a < 3; ++a)
+      dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo_[a]) / cell)) + 1);
+    cells_.resize(static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2]);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      std::array<int, 3> c;
+      for (int a = 0; a < 3; ++a) c[a] = index(points[i][a], a);
+      cells_[(static_cast<std::size_t>(c[2]) * dims_[1] + c[1]) * dims_[0] + c[0]].push_back(
+          static_cast<int>(i));
+    }
+  }
+
+  // -1 when no accepted point lies within `range`.
+  template <class Accept>
+  int nearest(const Vec3& p, double range, const Accept& accept) const {
+    std::array<int, 3> c;
+    double outside = 0;
+    for (int a = 0; a < 3; ++a) {
+      c[a] = index(p[a], a);
+      const double d = std::max({lo_[a] - p[a], p[a] - (lo_[a] + dims_[a] * cell_), 0.0});
+      outside += d * d;
+    }
+    outside = std::sqrt(outside);
+    double best = range;
+    int best_i = -1;
+    const int max_ring = std::max({dims_[0], dims_[1], dims_[2]});
+    for (int r = 0; r <= max_ring; ++r) {
+      if (best <= (r - 1) * cell_ - outside) break;
+      for (int z = std::max(0, c[2] - r); z <= std::min(dims_[2] - 1, c[2] + r); ++z)
+        for (int y = std::max(0, c[1] - r); y <= std::min(dims_[1] - 1, c[1] + r); ++y)
+          for (int x = std::max(0, c[0] - r); x <= std::min(dims_[0] - 1, c[0] + r); ++x) {
+            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;
+            for (int i : cells_[(static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x]) {
+              const double d = norm(sub(points_[i], p));
+              if (d < best && accept(i)) {
+                best = d;
+                best_i = i;
+              }
+            }
+          }
+    }
+    return best_i;
+  }
+
+ private:
+  int index(double v, int a) const {
+    return std::clamp(static_cast<int>(std::floor((v - lo_[a]) / cell_)), 0, dims_[a] - 1);
+  }
+  const std::vector<Vec3>& points_;
+  double cell_;
+  Vec3 lo_{};
+  std::array<int, 3> dims_{};
+  std::vector<std::vector<int>> cells_;
+};
+
+// Area-weighted vertex normals of a quad surface (each quad split along both diagonals).
+std::vector<Vec3> vertex_normals(const QuadSurface& q) {
+  std::vector<Vec3> n(q.vertices.size(), Vec3{0, 0, 0});
+  for (const auto& quad : q.quads) {
+    const Vec3 d =
+        cross(sub(q.vertices[quad[2]], q.vertices[quad[0]]), sub(q.vertices[quad[3]], q.vertices[quad[1]]));
+    for (int v : quad) n[v] = add(n[v], d);
+  }
+  for (Vec3& v : n) v = unit(v);
+  return n;
+}
+
+struct Correspondence {
+  std::vector<std::string> names;
+  std::vector<Vec3> sources, targets;
+};
+
+Correspondence correspond(const MandibleQuadTemplate& t, const TriSurface& surface,
+                          const Landmarks* landmarks, const std::string& file) {
+  Correspondence c;
+  if (!landmarks) {
+    const auto target = extreme_points(surface.vertices);
+    for (const auto& [name, p] : t.extremes) {
+      const auto it = target.find(name);
+      if (it == target.end())
+        throw InputError(
+            "the surface has no points on both sides of x = 0, so it is not a mandible in the "
+            "generator's frame (+x subject's left); give --landmarks or use --method grid");
+      c.names.push_back(name);
+      c.sources.push_back(p);
+      c.targets.push_back(it->second);
+    }
+    return c;
+  }
+  std::vector<std::string> missing;
+  for (const auto& [name, p] : t.reference) {
+    const auto q = landmarks->find(name);
+    if (!q) {
+      missing.push_back(name);
+      continue;
+    }
+    c.names.push_back(name);
+    c.sources.push_back(p);
+    c.targets.push_back(*q);
+  }
+  // Both condyles and the front must be pinned for the warp to place the rami and the body.
+  bool left = false, right = false, front = false;
+  for (const Vec3& p : c.sources) {
+    left = left || (p[0] > 20 && p[1] > 10);
+    right = right || (p[0] < -20 && p[1] > 10);
+    front = front || p[1] < -10;
+  }
+  if (c.names.size() < 6 || !left || !right || !front) {
+    std::string list;
+    for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
+    throw InputError("landmark file " + file + ": only " + std::to_string(c.names.size()) +
+                     " of the points that place the mandible template are in it (at least 6 are needed, on "
+                     "both rami and at the front); missing: " +
+                     list +
+                     ". Write them as 'hexbite generate mandible --landmarks' does, or leave out "
+                     "--landmarks to place the template by extreme points");
+  }
+  return c;
+}
+
+// Points derived from the surface's shape where landmark files have none but the template needs guidance:
+// per side the top of the condyle, the top of the coronoid process and the bottom of the sigmoid notch
+// between them (the notch depth varies much between mandibles). Searched among the surface vertices near
+// where the first warp puts the default mandible's points; names as in MandibleQuadTemplate::derived.
+std::map<std::string, Vec3> derive_points(const TriSurface& surface, const MandibleQuadTemplate& t,
+                                          const ThinPlateSpline& warp) {
+  std::map<std::string, Vec3> out;
+  // The highest vertex on one side (beyond 20 mm from the midline) within dy of around's y.
+  auto highest = [&](const Vec3& around, double side, double dy) {
+    const Vec3* best = nullptr;
+    for (const Vec3& v : surface.vertices)
+      if (side * v[0] > 20.0 && std::abs(v[1] - around[1]) < dy && (!best || v[2] > (*best)[2])) best = &v;
+    return best;
+  };
+  for (const auto& [side, sign] : {std::pair<std::string, double>{"left_", 1.0}, {"right_", -1.0}}) {
+    const Vec3* condyle = highest(warp(t.derived.at(side + "condyle_top")), sign, 10.0);
+    const Vec3* coronoid = highest(warp(t.derived.at(side + "coronoid_top")), sign, 20.0);
+    if (!condyle || !coronoid || (*condyle)[1] - (*coronoid)[1] < 12.0) continue;
+    // The notch: the lowest of the per-millimetre highest points between the two processes.
+    const double y0 = (*coronoid)[1] + 4.0, y1 = (*condyle)[1] - 4.0;
+    const double xm = 0.5 * ((*condyle)[0] + (*coronoid)[0]);
+    const int bins = static_cast<int>(std::ceil(y1 - y0));
+    std::vector<const Vec3*> top(static_cast<std::size_t>(bins), nullptr);
+    for (const Vec3& v : surface.vertices) {
+      if (sign * v[0] <= 0 || std::abs(v[0] - xm) > 12.0 || v[1] < y0 || v[1] >= y1) continue;
+      const int b = std::min(bins - 1, static_cast<int>(v[1] - y0));
+      if (!top[b] || v[2] > (*top[b])[2]) top[b] = &v;
+    }
+    const Vec3* notch = nullptr;
+    for (const Vec3* p : top)
+      if (p && (!notch || (*p)[2] < (*notch)[2])) notch = p;
+    if (!notch) continue;
+    const Vec3* back = nullptr;  // the back of the condyle head: the most posterior point near its top
+    for (const Vec3& v : surface.vertices)
+      if (std::abs(v[0] - (*condyle)[0]) < 10.0 && std::abs(v[2] - (*condyle)[2] + 5.0) < 5.0 &&
+          std::abs(v[1] - (*condyle)[1]) < 12.0 && (!back || v[1] > (*back)[1]))
+        back = &v;
+    out[side + "condyle_back"] = *back;
+    out[side + "condyle_top"] = *condyle;
+    out[side + "coronoid_top"] = *coronoid;
+    out[side + "sigmoid_notch"] = *notch;
+  }
+  // The incisal top: the highest point near the midline at the front.
+  const Vec3 incisal = warp(t.derived.at("incisal_top"));
+  const Vec3* top = nullptr;
+  for (const Vec3& v : surface.vertices)
+    if (std::abs(v[0]) < 4.0 && std::abs(v[1] - incisal[1]) < 10.0 && (!top || v[2] > (*top)[2])) top = &v;
+  if (top) out["incisal_top"] = *top;
+  return out;
+}
+
+// Per-chord subdivision counts n_c = max(1, round(L_c / h)) with h chosen so that the refined quad count
+// is closest to the target and even.
+std::vector<int> chord_counts(const std::vector<Chord>& chords, const std::vector<double>& chord_length,
+                              const std::vector<std::array<int, 2>>& quad_chords, int target) {
+  auto counts_for = [&](double h) {
+    std::vector<int> n(chords.size());
+    for (std::size_t c = 0; c < chords.size(); ++c)
+      n[c] = std::max(1, static_cast<int>(std::lround(chord_length[c] / h)));
+    return n;
+  };
+  auto total = [&](const std::vector<int>& n) {
+    long s = 0;
+    for (const auto& qc : quad_chords) s += static_cast<long>(n[qc[0]]) * n[qc[1]];
+    return s;
+  };
+  double lo = 1e-3, hi = 1e3;  // total(lo) >= target >= total(hi)
+  for (int it = 0; it < 100; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (total(counts_for(mid)) > target ? lo : hi) = mid;
+  }
+  std::vector<int> n = counts_for(hi);
+  if (std::abs(total(counts_for(lo)) - target) < std::abs(total(n) - target)) n = counts_for(lo);
+  if (total(n) % 2 != 0) {
+    // The single +-1 change of one chord's count that makes the total even and closest to the target.
+    long best_dev = std::numeric_limits<long>::max();
+    int best_c = -1, best_delta = 0;
+    for (std::size_t c = 0; c < chords.size(); ++c)
+      for (int delta : {-1, 1}) {
+        if (n[c] + delta < 1) continue;
+        n[c] += delta;
+        const long t = total(n);
+        n[c] -= delta;
+        if (t % 2 == 0 && std::abs(t - target) < best_dev) {
+          best_dev = std::abs(t - target);
+          best_c = static_cast<int>(c);
+          best_delta = delta;
+        }
+      }
+    if (best_c < 0) throw RunError("mandible quad mesh: no chord subdivision gives an even number of quads");
+    n[best_c] += best_delta;
+  }
+  return n;
+}
+
+// The refined quad surface: macro edge e gets n(e) - 1 interior nodes, each macro quad an n0 x n1 grid.
+QuadSurface refine(const QuadSurface& macro, const QuadEdges& edges, const std::vector<int>& edge_count) {
+  QuadSurface fine;
+  fine.vertices = macro.vertices;
+  std::vector<int> first_edge_node(edges.edges.size());
+  for (std::size_t e = 0; e < edges.edges.size(); ++e) {
+    first_edge_node[e] = static_cast<int>(fine.vertices.size());
+    const Vec3 &a = macro.vertices[edges.edges[e][0]], &b = macro.vertices[edges.edges[e][1]];
+    for (int k = 1; k < edge_count[e]; ++k) {
+      const double t = static_cast<double>(k) / edge_count[e];
+      fine.vertices.push_back(add(scale(a, 1 - t), scale(b, t)));
+    }
+  }
+  // Node k (0..n) of edge e walked from vertex `from`.
+  auto edge_node = [&](int e, int from, int k) {
+    const int n = edge_count[e];
+    const bool forward = edges.edges[e][0] == from;
+    const int j = forward ? k : n - k;
+    if (j == 0) return edges.edges[e][0];
+    if (j == n) return edges.edges[e][1];
+    return first_edge_node[e] + j - 1;
+  };
+  for (std::size_t q = 0; q < macro.quads.size(); ++q) {
+    const auto& c = macro.quads[q];
+    const auto& qe = edges.quad_edges[q];
+    const int nu = edge_count[qe[0]], nv = edge_count[qe[1]];
+    std::vector<int> grid(static_cast<std::size_t>(nu + 1) * (nv + 1));
+    auto at = [&](int i, int j) -> int& { return grid[static_cast<std::size_t>(j) * (nu + 1) + i]; };
+    for (int i = 0; i <= nu; ++i) {
+      at(i, 0) = edge_node(qe[0], c[0], i);
+      at(nu - i, nv) = edge_node(qe[2], c[2], i);
+    }
+    for (int j = 0; j <= nv; ++j) {
+      at(nu, j) = edge_node(qe[1], c[1], j);
+      at(0, nv - j) = edge_node(qe[3], c[3], j);
+    }
+    for (int j = 1; j < nv; ++j)
+      for (int i = 1; i < nu; ++i) {
+        const double u = static_cast<double>(i) / nu, v = static_cast<double>(j) / nv;
+        Vec3 p{0, 0, 0};
+        const double w[4] = {(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
+        for (int k = 0; k < 4; ++k) p = add(p, scale(macro.vertices[c[k]], w[k]));
+        at(i, j) = static_cast<int>(fine.vertices.size());
+        fine.vertices.push_back(p);
+      }
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i)
+        fine.quads.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+  }
+  return fine;
+}
+
+Vec3 bilinear(const QuadSurface& q, const std::array<int, 4>& quad, double u, double v) {
+  Vec3 p{0, 0, 0};
+  const double w[4] = {(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
+  for (int k = 0; k < 4; ++k) p = add(p, scale(q.vertices[quad[k]], w[k]));
+  return p;
+}
+
+// The input surface with what placement needs: closest-point queries (plain and restricted) and, per
+// input vertex, its area share and normal for the Lloyd step.
+struct PlacementSurface {
+  explicit PlacementSurface(const TriSurface& s)
+      : surface(s), projector(s), oriented(s), area(s.vertices.size(), 0.0), normal(s.vertices.size()) {
+    for (const auto& t : s.triangles) {
+      const Vec3 n = cross(sub(s.vertices[t[1]], s.vertices[t[0]]), sub(s.vertices[t[2]], s.vertices[t[0]]));
+      for (int v : t) {
+        area[v] += norm(n) / 6.0;
+        normal[v] = add(normal[v], n);
+      }
+    }
+    for (Vec3& n : normal) n = unit(n);
+  }
+  const TriSurface& surface;
+  SurfaceProjector projector;
+  OrientedProjector oriented;
+  std::vector<double> area;
+  std::vector<Vec3> normal;
+};
+
+// Restricted projection of every node (normal agreement with the quad mesh's vertex normal); returns the
+// input normal where each node landed.
+std::vector<Vec3> project(QuadSurface& q, const PlacementSurface& s) {
+  const std::vector<Vec3> normals = vertex_normals(q);
+  std::vector<Vec3> landed(q.vertices.size());
+  for (std::size_t v = 0; v < q.vertices.size(); ++v) {
+    SurfacePoint sp = s.oriented.closest(q.vertices[v], normals[v], Vec3{0, 0, 0});
+    if (sp.triangle < 0) sp = s.projector.closest(q.vertices[v]);  // nothing facing its way nearby
+    q.vertices[v] = sp.point;
+    landed[v] = sp.normal;
+  }
+  return landed;
+}
+
+// Relaxation sweeps: each free node moves tangentially toward the mean of the centroid of its quads'
+// centroids (Laplacian, for even quads) and the centroid of its restricted Voronoi region among the input
+// vertices (Lloyd, so that tips and ridges keep nodes), then back onto the surface with the restricted
+// projection, never onto a face whose normal opposes the one it left (*surface_normal, updated); nodes
+// move one at a time, and a move that folds more quad corners around the node than before is undone.
+void relax(QuadSurface& fine, const PlacementSurface& s, const std::vector<char>& fixed, int sweeps,
+           std::vector<Vec3>* surface_normal) {
+  std::vector<std::vector<int>> vertex_quads(fine.vertices.size());
+  for (std::size_t q = 0; q < fine.quads.size(); ++q)
+    for (int v : fine.quads[q]) vertex_quads[v].push_back(static_cast<int>(q));
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    const std::vector<Vec3> normals = vertex_normals(fine);
+    std::vector<Vec3> centroid(fine.quads.size());
+    for (std::size_t q = 0; q < fine.quads.size(); ++q) centroid[q] = bilinear(fine, fine.quads[q], 0.5, 0.5);
+    std::vector<Vec3> region(fine.vertices.size(), Vec3{0, 0, 0});
+    std::vector<double> region_area(fine.vertices.size(), 0.0);
+    const PointGrid grid(fine.vertices, 4.0);
+    for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
+      const int v = grid.nearest(s.surface.vertices[i], 20.0,
+                                 [&](int j) { return dot(normals[j], s.normal[i]) > kMinNormalAgreement; });
+      if (v < 0) continue;
+      region[v] = add(region[v], scale(s.surface.vertices[i], s.area[i]));
+      region_area[v] += s.area[i];
+    }
+    // Folded corners of the quads around v (corner normal against the input normal where that corner sits).
+    auto folded_around = [&](std::size_t v) {
+      int n = 0;
+      for (int q : vertex_quads[v]) {
+        const auto& quad = fine.quads[q];
+        for (int k = 0; k < 4; ++k) {
+          const Vec3& p = fine.vertices[quad[k]];
+          const Vec3 c =
+              cross(sub(fine.vertices[quad[(k + 1) % 4]], p), sub(fine.vertices[quad[(k + 3) % 4]], p));
+          if (dot(c, (*surface_normal)[quad[k]]) <= 0) ++n;
+        }
+      }
+      return n;
+    };
+    for (std::size_t v = 0; v < fine.vertices.size(); ++v) {
+      if (fixed[v] || vertex_quads[v].empty()) continue;
+      Vec3 target{0, 0, 0};
+      for (int q : vertex_quads[v]) target = add(target, centroid[q]);
+      target = scale(target, 1.0 / vertex_quads[v].size());
+      if (region_area[v] > 0) target = scale(add(target, scale(region[v], 1.0 / region_area[v])), 0.5);
+      Vec3 d = sub(target, fine.vertices[v]);
+      d = sub(d, scale(normals[v], dot(d, normals[v])));
+      const SurfacePoint sp =
+          s.oriented.closest(add(fine.vertices[v], scale(d, 0.8)), normals[v], (*surface_normal)[v]);
+      if (sp.triangle < 0) continue;  // no admissible move: the node stays this sweep
+      // Gauss-Seidel with a veto: a move that folds more corners around the node than before is undone.
+      const int before = folded_around(v);
+      const Vec3 old_point = fine.vertices[v], old_normal = (*surface_normal)[v];
+      fine.vertices[v] = sp.point;
+      (*surface_normal)[v] = sp.normal;
+      if (folded_around(v) > before) {
+        fine.vertices[v] = old_point;
+        (*surface_normal)[v] = old_normal;
+      }
+      if (before == 0 || folded_around(v) == 0) continue;
+      // Still folded: try the plain centroid of its quads, on whichever face suits the quad mesh, and keep
+      // it if it folds fewer corners.
+      const int still = folded_around(v);
+      const Vec3 kept_point = fine.vertices[v], kept_normal = (*surface_normal)[v];
+      Vec3 plain{0, 0, 0};
+      for (int q : vertex_quads[v]) plain = add(plain, centroid[q]);
+      const SurfacePoint untangled =
+          s.oriented.closest(scale(plain, 1.0 / vertex_quads[v].size()), normals[v], Vec3{0, 0, 0});
+      if (untangled.triangle < 0) continue;
+      fine.vertices[v] = untangled.point;
+      (*surface_normal)[v] = untangled.normal;
+      if (folded_around(v) >= still) {
+        fine.vertices[v] = kept_point;
+        (*surface_normal)[v] = kept_normal;
+      }
+    }
+  }
+}
+
+std::string point_text(const Vec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
+  return buf;
+}
+
+}  // namespace
+
+int quads_for_target_hexes(long target_hexes) {
+  const double q = 1300.0 * std::pow(static_cast<double>(target_hexes) / 2500.0, 2.0 / 3.0);
+  return std::max(24, 2 * static_cast<int>(std::lround(q / 2)));
+}
+
+QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmarks* landmarks,
+                                       const std::string& landmark_file, const MandibleQuadOptions& options,
+                                       MandibleQuadReport* report_out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (options.target_quads < 24 || options.target_quads > 200000)
+    throw InputError("--target-quads " + std::to_string(options.target_quads) +
+                     " is out of range: give a number from 24 to 200,000");
+  MandibleQuadReport report;
+  Progress progress("quad surface");
+  const MandibleQuadTemplate tmpl = mandible_quad_template();
+  report.macro_quads = static_cast<int>(tmpl.macro.quads.size());
+
+  // 1-2. Correspondence and warp.
+  const Correspondence corr = correspond(tmpl, surface, landmarks, landmark_file);
+  report.placement = landmarks ? "landmarks" : "extreme points";
+  report.matched_points = corr.names;
+  std::vector<double> lambda(corr.names.size());
+  for (std::size_t i = 0; i < lambda.size(); ++i)
+    lambda[i] = !landmarks                                              ? options.extreme_smoothing_mm
+                : corr.names[i].find(".insertion") != std::string::npos ? options.insertion_smoothing_mm
+                                                                        : options.landmark_smoothing_mm;
+  const ThinPlateSpline first_warp(corr.sources, corr.targets, lambda);
+  Correspondence all = corr;
+  const std::map<std::string, Vec3> features = derive_points(surface, tmpl, first_warp);
+  for (const auto& [name, p] : features) {
+    all.names.push_back(name);
+    all.sources.push_back(tmpl.derived.at(name));
+    all.targets.push_back(p);
+    lambda.push_back(options.landmark_smoothing_mm);
+  }
+  const ThinPlateSpline warp(all.sources, all.targets, lambda);
+  for (std::size_t i = 0; i < corr.sources.size(); ++i)
+    report.warp_residual_mm =
+        std::max(report.warp_residual_mm, norm(sub(warp(corr.sources[i]), corr.targets[i])));
+  QuadSurface macro = tmpl.macro;
+  for (Vec3& v : macro.vertices) v = warp(v);
+  progress.update(0.1, "warped");
+
+  // 3. Chord subdivision counts from the warped rung lengths.
+  const QuadEdges macro_edges = build_quad_edges(macro.quads);
+  const std::vector<Chord> chords = find_chords(macro.quads, macro_edges);
+  std::vector<int> edge_chord(macro_edges.edges.size(), -1);
+  std::vector<double> chord_length(chords.size(), 0.0);
+  for (std::size_t c = 0; c < chords.size(); ++c) {
+    for (int e : chords[c].edges) {
+      edge_chord[e] = static_cast<int>(c);
+      chord_length[c] +=
+          norm(sub(macro.vertices[macro_edges.edges[e][1]], macro.vertices[macro_edges.edges[e][0]]));
+    }
+    chord_length[c] /= chords[c].length();
+  }
+  std::vector<std::array<int, 2>> quad_chords(macro.quads.size());
+  for (std::size_t q = 0; q < macro.quads.size(); ++q)
+    quad_chords[q] = {edge_chord[macro_edges.quad_edges[q][0]], edge_chord[macro_edges.quad_edges[q][1]]};
+  const std::vector<int> counts = chord_counts(chords, chord_length, quad_chords, options.target_quads);
+  std::vector<int> edge_count(macro_edges.edges.size());
+  for (std::size_t e = 0; e < edge_count.size(); ++e) edge_count[e] = counts[edge_chord[e]];
+
+  // 4. Refinement and restricted projection.
+  QuadSurface fine = refine(macro, macro_edges, edge_count);
+  std::vector<char> fixed(fine.vertices.size(), 0);
+  const PlacementSurface target(surface);
+  const SurfaceProjector& projector = target.projector;
+  std::vector<Vec3> surface_normal = project(fine, target);
+  progress.update(0.3, "refined");
+
+  // 5. Landmark nodes, fixed from here on.
+  if (landmarks)
+    for (const auto& [name, p] : landmarks->points) {
+      const SurfacePoint on_surface = projector.closest(p);
+      int best = -1;
+      double best_d = std::numeric_limits<double>::infinity();
+      for (std::size_t v = 0; v < fine.vertices.size(); ++v) {
+        const double d = norm(sub(fine.vertices[v], on_surface.point));
+        if (!fixed[v] && d < best_d) {
+          best_d = d;
+          best = static_cast<int>(v);
+        }
+      }
+      fine.vertices[best] = on_surface.point;
+      surface_normal[best] = on_surface.normal;
+      fixed[best] = 1;
+      report.landmark_nodes.push_back({name, norm(sub(on_surface.point, p))});
+    }
+
+  // 6. Relaxation on the target.
+  relax(fine, target, fixed, options.relax_sweeps, &surface_normal);
+  progress.update(0.9, "relaxed");
+
+  // 7. Fidelity.
+  const QuadEdges fine_edges = build_quad_edges(fine.quads);
+  double edge_sum = 0;
+  for (const auto& e : fine_edges.edges) edge_sum += norm(sub(fine.vertices[e[1]], fine.vertices[e[0]]));
+  report.mean_edge_mm = edge_sum / fine_edges.edges.size();
+  for (const Vec3& v : fine.vertices)
+    report.max_vertex_distance_mm = std::max(report.max_vertex_distance_mm, projector.distance(v));
+  Vec3 worst_quad{0, 0, 0};
+  for (const auto& quad : fine.quads)
+    for (int j = 0; j <= 4; ++j)
+      for (int i = 0; i <= 4; ++i) {
+        const Vec3 p = bilinear(fine, quad, i / 4.0, j / 4.0);
+        const double d = projector.distance(p);
+        if (d > report.quads_to_surface_mm) {
+          report.quads_to_surface_mm = d;
+          worst_quad = p;
+        }
+      }
+  TriSurface quad_triangles;
+  quad_triangles.vertices = fine.vertices;
+  for (const auto& quad : fine.quads) {
+    const int centre = static_cast<int>(quad_triangles.vertices.size());
+    quad_triangles.vertices.push_back(bilinear(fine, quad, 0.5, 0.5));
+    for (int k = 0; k < 4; ++k) quad_triangles.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
+  }
+  const SurfaceProjector quad_projector(quad_triangles);
+  Vec3 worst_surface{0, 0, 0};
+  for (const Vec3& v : surface.vertices) {
+    const double d = quad_projector.distance(v);
+    if (d > report.surface_to_quads_mm) {
+      report.surface_to_quads_mm = d;
+      worst_surface = v;
+    }
+  }
+  report.hausdorff_mm = std::max(report.quads_to_surface_mm, report.surface_to_quads_mm);
+  report.worst_quad_point = worst_quad;
+  report.worst_surface_point = worst_surface;
+  for (const auto& quad : fine.quads)
+    for (int k = 0; k < 4; ++k) {
+      const Vec3& p = fine.vertices[quad[k]];
+      const Vec3 n =
+          cross(sub(fine.vertices[quad[(k + 1) % 4]], p), sub(fine.vertices[quad[(k + 3) % 4]], p));
+      if (dot(n, projector.closest(p).normal) <= 0) {
+        ++report.folded_quads;
+        break;
+      }
+    }
+  if (report.hausdorff_mm > options.max_hausdorff_mm) {
+    const bool missed = report.surface_to_quads_mm >= report.quads_to_surface_mm;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.1f mm", report.hausdorff_mm);
+    throw InputError(
+        std::string("the surface does not fit the mandible template: the placed quad surface is ") + buf +
+        (missed ? " away from the surface at " + point_text(worst_surface)
+                : " off the surface at " + point_text(worst_quad)) +
+        " (limit " + std::to_string(static_cast<int>(options.max_hausdorff_mm)) +
+        " mm). The surface must be a whole mandible in the generator's frame (+x subject's left, "
+        "+y posterior, +z superior, mm)" +
+        (landmarks ? " with landmarks in the same frame" : "; --landmarks helps place it") +
+        ", or use --method grid");
+  }
+  report.quads = static_cast<int>(fine.quads.size());
+  const std::vector<Chord> fine_chords = find_chords(fine.quads, fine_edges);
+  report.chords = static_cast<int>(fine_chords.size());
+  for (const Chord& c : fine_chords) report.max_chord_length = std::max(report.max_chord_length, c.length());
+  report.seconds = seconds_since(t0);
+  progress.finish();
+  if (report_out) *report_out = report;
+  return fine;
+}
+
+}  // namespace hexbite

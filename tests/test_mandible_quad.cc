@@ -1,0 +1,272 @@
+// From a triangulated mandible to a quad surface for the sheet mesher: the macro-element template, its
+// placement and refinement (mesher/quad_surface_placement.h), `hexbite quad from-mandible` and
+// `hexbite mesh SURFACE --method sheets`.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/error.h"
+#include "mesher/mandible_generator.h"
+#include "mesher/mandible_quad_template.h"
+#include "mesher/quad_check.h"
+#include "mesher/quad_surface_io.h"
+#include "mesher/quad_surface_placement.h"
+#include "mesher/surface_check.h"
+#include "mesher/surface_projector.h"
+#include "mesher/thin_plate_spline.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+// The default mandible is generated once for the whole suite (about 0.3 s).
+const GeneratedMandible& mandible() {
+  static const GeneratedMandible m = generate_mandible(MandibleParameters{});
+  return m;
+}
+
+double distance(const Vec3& a, const Vec3& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+// What the sheet mesher needs of a quad surface, checked independently of the placement's own report.
+void expect_usable_ball(const QuadSurface& q) {
+  const QuadSurfaceReport r = check_quad_surface(q, "quads");
+  EXPECT_TRUE(r.usable()) << (r.problems.empty() ? "" : r.problems.front());
+  EXPECT_TRUE(r.ball);
+  EXPECT_EQ(r.genus, 0);
+  EXPECT_TRUE(r.even);
+  EXPECT_EQ(r.quads % 2, 0);
+  EXPECT_TRUE(r.simple);
+  EXPECT_TRUE(r.three_connected);
+  EXPECT_TRUE(r.chords_computed);
+  EXPECT_TRUE(r.self_intersecting_chords.empty());
+  EXPECT_EQ(r.unused_vertices, 0);
+}
+
+TEST(MandibleQuadTemplate, IsAPolycubeBallWithSimpleChordsAndNamedNodes) {
+  const MandibleQuadTemplate t = mandible_quad_template();
+  expect_usable_ball(t.macro);
+  // 22 macro hexes (6 body cells, 2 x 8 in the rami and processes) bound by 82 quads.
+  EXPECT_EQ(t.macro.quads.size(), 82u);
+  // Mirror symmetric about x = 0: every vertex has a mirror image among the vertices.
+  for (const Vec3& v : t.macro.vertices) {
+    bool found = false;
+    for (const Vec3& w : t.macro.vertices) found = found || distance(w, {-v[0], v[1], v[2]}) < 1e-9;
+    EXPECT_TRUE(found) << v[0] << " " << v[1] << " " << v[2];
+  }
+  // Outward orientation: the enclosed volume (quads split in two triangles) is positive.
+  TriSurface tris;
+  tris.vertices = t.macro.vertices;
+  for (const auto& q : t.macro.quads) {
+    tris.triangles.push_back({q[0], q[1], q[2]});
+    tris.triangles.push_back({q[0], q[2], q[3]});
+  }
+  EXPECT_GT(enclosed_volume(tris), 10000.0);
+  // Key nodes sit where their names say: the left condyle top behind and above the left coronoid tip.
+  const Vec3& condyle = t.macro.vertices[t.key_nodes.at("left_condyle_top_back")];
+  const Vec3& coronoid = t.macro.vertices[t.key_nodes.at("left_coronoid_tip_front")];
+  const Vec3& gonion = t.macro.vertices[t.key_nodes.at("left_gonion_corner")];
+  EXPECT_GT(condyle[1], coronoid[1]);
+  EXPECT_GT(condyle[0], 0);
+  EXPECT_LT(gonion[2], coronoid[2] - 30);
+  EXPECT_LT(distance(gonion, t.reference.at("left_gonion")), 8.0);
+}
+
+TEST(ThinPlateSpline, InterpolatesWithoutSmoothingAndRejectsCoplanarPoints) {
+  const std::vector<Vec3> src = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {0, 0, 10}, {5, 5, 5}};
+  const std::vector<Vec3> dst = {{1, 0, 0}, {12, 1, 0}, {0, 11, 2}, {1, 0, 9}, {6, 7, 5}};
+  const ThinPlateSpline f(src, dst, std::vector<double>(5, 0.0));
+  for (std::size_t i = 0; i < src.size(); ++i) EXPECT_LT(distance(f(src[i]), dst[i]), 1e-9);
+  // An affine map is reproduced everywhere, whatever the smoothing.
+  std::vector<Vec3> affine;
+  for (const Vec3& p : src) affine.push_back({2 * p[0] + 1, p[1] - p[2], 3 * p[2]});
+  const ThinPlateSpline g(src, affine, std::vector<double>(5, 10.0));
+  const Vec3 x{3, 4, 5}, y = g(x);
+  EXPECT_LT(distance(y, {7, -1, 15}), 1e-9);
+  const std::vector<Vec3> flat = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  EXPECT_THROW(ThinPlateSpline(flat, flat, std::vector<double>(4, 0.0)), InputError);
+}
+
+TEST(MandibleQuads, GeneratedMandibleWithLandmarks) {
+  const GeneratedMandible& m = mandible();
+  MandibleQuadReport r;
+  const QuadSurface q = quad_surface_from_mandible(m.surface, &m.landmarks, "m.yaml", {}, &r);
+  expect_usable_ball(q);
+  EXPECT_EQ(r.quads, static_cast<int>(q.quads.size()));
+  EXPECT_GT(r.quads, 1100);
+  EXPECT_LT(r.quads, 1500);
+  EXPECT_EQ(r.macro_quads, 82);
+  EXPECT_EQ(r.placement, "landmarks");
+  EXPECT_EQ(r.matched_points.size(), 29u);  // 11 landmarks + 18 insertions
+  EXPECT_EQ(r.folded_quads, 0);
+  // Every vertex on the input surface; the quad surface close to it both ways (sampled independently).
+  const SurfaceProjector input(m.surface);
+  for (const Vec3& v : q.vertices) ASSERT_LT(input.distance(v), 1e-6);
+  for (const auto& quad : q.quads) {
+    Vec3 c{0, 0, 0};
+    for (int v : quad)
+      for (int a = 0; a < 3; ++a) c[a] += q.vertices[v][a] / 4;
+    ASSERT_LT(input.distance(c), r.quads_to_surface_mm + 1e-9);
+  }
+  EXPECT_LT(r.hausdorff_mm, 2.5);
+  EXPECT_LT(r.max_vertex_distance_mm, 1e-6);
+  // Every landmark is hit by a quad node at its closest surface point.
+  ASSERT_EQ(r.landmark_nodes.size(), m.landmarks.points.size());
+  for (const auto& [name, p] : m.landmarks.points) {
+    const Vec3 target = input.closest(p).point;
+    double best = 1e9;
+    for (const Vec3& v : q.vertices) best = std::min(best, distance(v, target));
+    EXPECT_LT(best, 1e-9) << name;
+  }
+}
+
+TEST(MandibleQuads, TargetDensityParityAndDeterminism) {
+  const GeneratedMandible& m = mandible();
+  for (int target : {400, 3000}) {
+    MandibleQuadOptions o;
+    o.target_quads = target;
+    MandibleQuadReport r;
+    const QuadSurface q = quad_surface_from_mandible(m.surface, &m.landmarks, "m.yaml", o, &r);
+    SCOPED_TRACE(target);
+    EXPECT_EQ(q.quads.size() % 2, 0u);
+    EXPECT_GT(r.quads, 0.75 * target);
+    EXPECT_LT(r.quads, 1.25 * target);
+    expect_usable_ball(q);
+    if (target == 3000) {  // denser stays close, with hardly any fold
+      EXPECT_LT(r.hausdorff_mm, 3.5);
+      EXPECT_LE(r.folded_quads, 5);
+    }
+  }
+  MandibleQuadOptions o;
+  o.target_quads = 500;
+  const QuadSurface a = quad_surface_from_mandible(m.surface, nullptr, "", o);
+  const QuadSurface b = quad_surface_from_mandible(m.surface, nullptr, "", o);
+  EXPECT_EQ(a.quads, b.quads);
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_EQ(quads_for_target_hexes(2500), 1300);
+  EXPECT_EQ(quads_for_target_hexes(20000) % 2, 0);
+}
+
+TEST(MandibleQuads, ExtremePointsWithoutLandmarkFile) {
+  const GeneratedMandible& m = mandible();
+  MandibleQuadReport r;
+  const QuadSurface q = quad_surface_from_mandible(m.surface, nullptr, "", {}, &r);
+  expect_usable_ball(q);
+  EXPECT_EQ(r.placement, "extreme points");
+  EXPECT_EQ(r.matched_points.size(), 8u);
+  EXPECT_TRUE(r.landmark_nodes.empty());
+  EXPECT_LE(r.folded_quads, 5);
+  EXPECT_LT(r.hausdorff_mm, 4.0);
+}
+
+TEST(MandibleQuads, RealJawWithItsLandmarks) {
+  const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
+  const Landmarks lm = read_landmarks(test::shared_data("jaw/landmarks.yaml"));
+  MandibleQuadReport r;
+  const QuadSurface q = quad_surface_from_mandible(jaw, &lm, "landmarks.yaml", {}, &r);
+  expect_usable_ball(q);
+  EXPECT_EQ(r.matched_points.size(), 22u);  // 4 landmarks + 18 insertions
+  EXPECT_GT(r.quads, 1100);
+  EXPECT_LT(r.quads, 1500);
+  EXPECT_LT(r.max_vertex_distance_mm, 1e-6);
+  EXPECT_LT(r.hausdorff_mm, 4.0);
+  // Without its landmark file the jaw is placed by its extreme points.
+  MandibleQuadReport e;
+  expect_usable_ball(quad_surface_from_mandible(jaw, nullptr, "", {}, &e));
+  EXPECT_EQ(e.placement, "extreme points");
+  EXPECT_LT(e.hausdorff_mm, 4.5);
+}
+
+TEST(MandibleQuads, LandmarkFileWithoutTheNeededPointsIsRejectedByName) {
+  Landmarks lm;
+  lm.points["left_condyle_tmj_point"] = {50, 31, 79};
+  lm.points["incisal_point"] = {0, -39, 44};
+  try {
+    quad_surface_from_mandible(mandible().surface, &lm, "few.yaml", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("few.yaml"), std::string::npos) << what;
+    EXPECT_NE(what.find("right_condyle_tmj_point"), std::string::npos) << what;
+    EXPECT_NE(what.find("left_gonion"), std::string::npos) << what;
+  }
+}
+
+// A box where a mandible should be: placed by its extreme points, the template cannot fit it.
+TEST(MandibleQuads, NonMandibleSurfaceIsRejected) {
+  TriSurface box;
+  for (int i = 0; i < 8; ++i)
+    box.vertices.push_back({i & 1 ? 50.0 : -50.0, i & 2 ? 35.0 : -45.0, i & 4 ? 80.0 : 5.0});
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    box.triangles.push_back({f[0], f[1], f[2]});
+    box.triangles.push_back({f[0], f[2], f[3]});
+  }
+  ASSERT_GT(enclosed_volume(box), 0);
+  try {
+    quad_surface_from_mandible(box, nullptr, "", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not fit the mandible template"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(MandibleQuadsCli, FromMandibleWritesACheckedQuadSurface) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(test::run_hexbite({"generate", "mandible", "-o", dir + "/m.stl", "--landmarks", dir + "/m.yaml"})
+                .exit_code,
+            0);
+  const auto r = test::run_hexbite({"quad", "from-mandible", dir + "/m.stl", "--landmarks", dir + "/m.yaml",
+                                    "-o", dir + "/q.obj", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"macro_quads", "quads", "chords", "max_chord_length", "hausdorff_mm"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["quads"].get<int>() % 2, 0);
+  EXPECT_EQ(j["self_intersecting_chords"].get<int>(), 0);
+  const QuadSurface q = read_quad_surface(dir + "/q.obj");
+  EXPECT_EQ(static_cast<int>(q.quads.size()), j["quads"].get<int>());
+  const auto check = test::run_hexbite({"quad", "check", dir + "/q.obj"});
+  EXPECT_EQ(check.exit_code, 0) << check.err;
+}
+
+TEST(MandibleQuadsCli, BadLandmarkFilesExitWithCode2AndNameTheFile) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(test::run_hexbite({"generate", "mandible", "-o", dir + "/m.stl"}).exit_code, 0);
+  const auto missing = test::run_hexbite(
+      {"quad", "from-mandible", dir + "/m.stl", "--landmarks", dir + "/nope.yaml", "-o", dir + "/q.obj"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("nope.yaml"), std::string::npos) << missing.err;
+  test::write_file(dir + "/few.yaml", "landmarks:\n  left_condyle_tmj_point: [49.7, 31.0, 79.2]\n");
+  const auto few = test::run_hexbite(
+      {"mesh", dir + "/m.stl", "--method", "sheets", "--landmarks", dir + "/few.yaml", "-o", dir + "/m.vtu"});
+  EXPECT_EQ(few.exit_code, 2);
+  EXPECT_NE(few.err.find("few.yaml"), std::string::npos) << few.err;
+  EXPECT_NE(few.err.find("right_condyle_tmj_point"), std::string::npos) << few.err;
+  EXPECT_FALSE(std::ifstream(dir + "/q.obj").good());
+  EXPECT_FALSE(std::ifstream(dir + "/m.vtu").good());
+}
+
+TEST(MandibleQuadsCli, MeshSheetsFromTheTriangleSurface) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(test::run_hexbite({"generate", "mandible", "-o", dir + "/m.stl", "--landmarks", dir + "/m.yaml"})
+                .exit_code,
+            0);
+  const auto r = test::run_hexbite({"mesh", dir + "/m.stl", "--method", "sheets", "--landmarks",
+                                    dir + "/m.yaml", "-o", dir + "/m.vtu", "--json", "--allow-invalid"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["method"], "sheets");
+  EXPECT_EQ(j["quads"], j["quad_surface"]["quads"]);
+  EXPECT_GT(j["hexes"].get<int>(), 0);
+  EXPECT_LE(j["hexes"].get<int>(), 3000);
+  EXPECT_TRUE(std::ifstream(dir + "/m.vtu").good());
+}
+
+}  // namespace
+}  // namespace hexbite
