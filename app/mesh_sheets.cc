@@ -30,8 +30,8 @@ std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
   out << "Meshed " << o.quad_surface << " (cycle elimination, " << elimination_order_name(r.order)
       << "): " << r.quads << " boundary quads, " << r.chords << " chords, " << r.eliminations
       << " eliminations (" << r.eliminations_single << " single, " << r.eliminations_k_step << " k-step; "
-      << r.external_sheets << " external, " << r.internal_sheets << " internal sheets), " << r.hexes
-      << " hexes, " << r.interior_vertices << " interior nodes\n";
+      << r.external_sheets << " external, " << r.internal_sheets << " internal sheets), " << r.decompositions
+      << " decompositions, " << r.hexes << " hexes, " << r.interior_vertices << " interior nodes\n";
   out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
       << q.node_degree.max_edges << "\n";
   out << "interior node degrees (hexes): " << histogram_text(q.node_degree.hexes) << "; maximum "
@@ -53,8 +53,8 @@ std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
 void run_mesh_sheets(const MeshSheetsOptions& o) {
   if (o.quad_surface.empty())
     throw InputError(
-        "--method sheets needs --quad-surface Q.obj (a quad surface of a ball); meshing a triangle surface "
-        "with sheets (through a macro-element quad mesh) is not available yet: use --method grid for it");
+        "--method sheets needs a SURFACE (a mandible: the quad template is placed on it) or --quad-surface "
+        "Q.obj (a quad surface of a ball)");
   const EliminationOrder order = parse_elimination_order(o.order);
   const QuadSurface surface = read_quad_surface(o.quad_surface);
   SheetMeshOptions options;
@@ -83,6 +83,7 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
     j["chords_eliminated"] = report.chords_eliminated;
     j["external_sheets"] = report.external_sheets;
     j["internal_sheets"] = report.internal_sheets;
+    j["decompositions"] = report.decompositions;
     j["hexes"] = report.hexes;
     j["interior_nodes"] = report.interior_vertices;
     j["seconds"] = {{"elimination", report.seconds_elimination}, {"embedding", report.seconds_embedding}};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 
 #include "common/error.h"
 #include "mesher/elimination_feasibility.h"
@@ -407,6 +408,9 @@ std::string quad_text(const Quad& q, int input_vertices) {
   return s + "]";
 }
 
+// The last sentence of the RunError when no elimination is feasible.
+constexpr const char* kStuckAdvice = ". Refine the quad surface there or mesh the solid with --method grid";
+
 // The RunError text when no elimination is feasible: the remaining chords with their lengths and quads
 // (input vertex ids; "new" for interior vertices created by earlier eliminations).
 std::string stuck_message(const std::vector<Quad>& quads, const std::vector<Chord>& chords, int done,
@@ -424,7 +428,7 @@ std::string stuck_message(const std::vector<Quad>& quads, const std::vector<Chor
     s += chords[i].quads.size() > 4 ? " ...)" : ")";
   }
   if (chords.size() > 12) s += "; ...";
-  return s + ". Refine the quad surface there or mesh the solid with --method grid";
+  return s + kStuckAdvice;
 }
 
 // The single hex of a cube surface: the first quad is its bottom, the top corners are the bottom corners'
@@ -584,33 +588,147 @@ HexMesh build_hex_complex(const QuadSurface& surface, const EliminationScheme& s
   return mesh;
 }
 
+namespace {
+
+// Step 3: barycentric smoothing and the optimizer, with the first n vertices (the boundary) fixed.
+OptimizeReport embed(HexMesh& mesh, int n, const SheetMeshOptions& options) {
+  std::vector<char> interior(mesh.vertices.size(), 0), fixed(mesh.vertices.size(), 0);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) (static_cast<int>(v) < n ? fixed : interior)[v] = 1;
+  barycentric_smoothing(mesh, interior, options.smoothing_iterations);
+  return options.optimize ? optimize_hex_mesh(mesh, nullptr, fixed, options.optimizer) : OptimizeReport{};
+}
+
+using Edge = std::array<int, 2>;
+
+Edge edge_of(int a, int b) {
+  return {std::min(a, b), std::max(a, b)};
+}
+
+// Whether the edges that both part complexes have between the disk's vertices are exactly the disk's
+// edges (part vertex ids as in PrimalCycleSplit::ids; n: the vertices of the split surface).
+bool meet_in_disk(const std::array<HexMesh, 2>& parts, const PrimalCycleSplit& split, int n) {
+  auto on_disk = [&](int v) {
+    return v >= n ? v < n + split.disk_vertices : std::count(split.cycle.begin(), split.cycle.end(), v) > 0;
+  };
+  static constexpr int kHexEdges[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                           {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  std::array<std::vector<Edge>, 2> edges;
+  for (int s = 0; s < 2; ++s) {
+    const std::vector<int>& id = split.ids[s];
+    for (const auto& hex : parts[s].hexes)
+      for (const auto& e : kHexEdges) {
+        const int a = hex[e[0]], b = hex[e[1]];
+        if (a < static_cast<int>(id.size()) && b < static_cast<int>(id.size()) && on_disk(id[a]) &&
+            on_disk(id[b]))
+          edges[s].push_back(edge_of(id[a], id[b]));
+      }
+    std::sort(edges[s].begin(), edges[s].end());
+    edges[s].erase(std::unique(edges[s].begin(), edges[s].end()), edges[s].end());
+  }
+  std::vector<Edge> common, disk;
+  std::set_intersection(edges[0].begin(), edges[0].end(), edges[1].begin(), edges[1].end(),
+                        std::back_inserter(common));
+  for (const auto& q : split.disk)
+    for (int k = 0; k < 4; ++k) disk.push_back(edge_of(q[k], q[(k + 1) % 4]));
+  std::sort(disk.begin(), disk.end());
+  disk.erase(std::unique(disk.begin(), disk.end()), disk.end());
+  return common == disk;
+}
+
+// Steps 1 and 2 for `surface`, decomposing it along a primal cycle when the elimination is stuck (depth:
+// the nesting of the decomposition that made it). Adds the counts of eliminations, sheets and
+// decompositions to `counts`. The result's vertices 0..n-1 are the surface's.
+HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& options, int depth,
+                      SheetMeshReport& counts) {
+  EliminationScheme scheme;
+  try {
+    scheme = eliminate_chords(surface, options.elimination);
+  } catch (const RunError& stuck) {
+    if (depth >= options.decomposition.max_depth) throw;
+    const int n = static_cast<int>(surface.vertices.size());
+    HexMesh glued;
+    const DecompositionSearch search =
+        search_primal_cycle_splits(surface, options.decomposition, [&](const PrimalCycleSplit& split) {
+          std::array<HexMesh, 2> parts;
+          SheetMeshReport part_counts;
+          try {
+            for (int s = 0; s < 2; ++s)
+              parts[s] = sheet_complex(split.parts[s], options, depth + 1, part_counts);
+          } catch (const RunError&) {
+            return false;
+          }
+          // The parts may meet only in the disk: an edge of both between two disk vertices that is no disk
+          // edge (possible where the parts' elimination connected cycle vertices) would not be conforming.
+          if (!meet_in_disk(parts, split, n)) return false;
+          // The surface's vertices, the disk's, then the parts' interior vertices part by part.
+          glued.vertices = surface.vertices;
+          glued.vertices.insert(glued.vertices.end(), split.disk_positions.begin(),
+                                split.disk_positions.end());
+          for (int s = 0; s < 2; ++s) {
+            std::vector<int> id = split.ids[s];
+            const int k = static_cast<int>(id.size());
+            for (int v = k; v < static_cast<int>(parts[s].vertices.size()); ++v) {
+              id.push_back(static_cast<int>(glued.vertices.size()));
+              glued.vertices.push_back(parts[s].vertices[v]);
+            }
+            for (auto hex : parts[s].hexes) {
+              for (int& v : hex) v = id[v];
+              glued.hexes.push_back(hex);
+            }
+          }
+          counts.eliminations_single += part_counts.eliminations_single;
+          counts.eliminations_k_step += part_counts.eliminations_k_step;
+          counts.chords_eliminated += part_counts.chords_eliminated;
+          counts.external_sheets += part_counts.external_sheets;
+          counts.internal_sheets += part_counts.internal_sheets;
+          counts.decompositions += part_counts.decompositions + 1;
+          return true;
+        });
+    if (search.accepted) return glued;
+    std::string message = stuck.what();
+    const std::string advice = kStuckAdvice;
+    if (message.size() >= advice.size() &&
+        message.compare(message.size() - advice.size(), advice.size(), advice) == 0)
+      message.resize(message.size() - advice.size());
+    throw RunError(message + ". Decomposition along a primal cycle did not help either: " +
+                   std::to_string(search.cycles) + " primal cycles of even length up to " +
+                   std::to_string(options.decomposition.max_cycle_length) + " gave " +
+                   std::to_string(search.splits) +
+                   " splits into two usable balls (a side plus an internal quad disk)" +
+                   (search.splits ? ", none with two parts that could be meshed (nesting depth " +
+                                        std::to_string(options.decomposition.max_depth) + ")"
+                                  : "") +
+                   advice);
+  }
+  std::vector<SheetKind> kinds;
+  HexMesh mesh = build_hex_complex(surface, scheme, options.internal_sheets, &kinds);
+  for (std::size_t i = 0; i < kinds.size(); ++i) {
+    const Elimination& e = scheme.eliminations[i];
+    (e.chords > 1 ? counts.eliminations_k_step : counts.eliminations_single) += 1;
+    (kinds[i] == SheetKind::kInternal ? counts.internal_sheets : counts.external_sheets) += 1;
+    counts.chords_eliminated += e.chords;
+  }
+  return mesh;
+}
+
+}  // namespace
+
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
                                   SheetMeshReport* report) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  const EliminationScheme scheme = eliminate_chords(surface, options.elimination);
-  std::vector<SheetKind> kinds;
-  HexMesh mesh = build_hex_complex(surface, scheme, options.internal_sheets, &kinds);
+  SheetMeshReport counts;
+  HexMesh mesh = sheet_complex(surface, options, 0, counts);
   const auto t1 = Clock::now();
-  const int n = scheme.input_vertices;
-  std::vector<char> interior(mesh.vertices.size(), 0), fixed(mesh.vertices.size(), 0);
-  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) (static_cast<int>(v) < n ? fixed : interior)[v] = 1;
-  barycentric_smoothing(mesh, interior, options.smoothing_iterations);
-  OptimizeReport opt;
-  if (options.optimize) opt = optimize_hex_mesh(mesh, nullptr, fixed, options.optimizer);
+  const int n = static_cast<int>(surface.vertices.size());
+  OptimizeReport opt = embed(mesh, n, options);
   const auto t2 = Clock::now();
   if (report) {
     SheetMeshReport& r = *report;
-    r = SheetMeshReport{};
+    r = counts;
     r.quads = static_cast<int>(surface.quads.size());
     r.chords = static_cast<int>(find_chords(surface.quads, build_quad_edges(surface.quads)).size());
-    r.eliminations = static_cast<int>(scheme.eliminations.size());
-    for (std::size_t i = 0; i < kinds.size(); ++i) {
-      const Elimination& e = scheme.eliminations[i];
-      (e.chords > 1 ? r.eliminations_k_step : r.eliminations_single) += 1;
-      (kinds[i] == SheetKind::kInternal ? r.internal_sheets : r.external_sheets) += 1;
-      r.chords_eliminated += e.chords;
-    }
+    r.eliminations = r.eliminations_single + r.eliminations_k_step;
     r.hexes = static_cast<int>(mesh.hexes.size());
     r.interior_vertices = static_cast<int>(mesh.vertices.size()) - n;
     r.order = options.elimination.order;

@@ -41,9 +41,15 @@
 // instead of two disk sheets), which is why only the geometric order weighs them.
 // Internal sheets (mesher/internal_sheet.h) replace external ones during the construction where their
 // conditions hold (SheetMeshOptions::internal_sheets).
-// Not yet done: decomposition along a primal cycle.
+// Decomposition (mesh_by_cycle_elimination() only, mesher/primal_cycle_decomposition.h): when the
+// elimination of a surface gets stuck, the surface is split along a short even primal cycle spanned by a
+// quad disk into two balls (each side plus the disk); each part is meshed in the same way (elimination,
+// construction, and a nested decomposition up to DecompositionOptions::max_depth), the first split whose
+// two parts both mesh is taken, and the two complexes are glued along the disk (the same vertices and
+// quads, so the result is conforming; the disk's vertices are new interior vertices).
 // Failure: when no elimination is feasible before the cube, RunError naming the remaining chords and some of
-// their quads, suggesting --method grid.
+// their quads, suggesting --method grid; from mesh_by_cycle_elimination() only when no decomposition helps
+// either, saying how many cycles and splits were tried.
 // Cost: per step, the chords and sides O(C F) for C chords and F quads, each feasibility test O(F log F);
 // kFewestHexes usually tests one candidate per step, the look-ahead orders up to all candidates of the next
 // step; the geometric order also measures the rail angles and the flatness of every candidate, O(C F) per
@@ -59,6 +65,7 @@
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_optimize.h"
 #include "mesher/hex_quality.h"
+#include "mesher/primal_cycle_decomposition.h"
 
 namespace hexbite {
 
@@ -117,6 +124,8 @@ struct SheetMeshOptions {
   // Internal sheets where their conditions hold (build_hex_complex); never worse in the measured cases,
   // valid where the external sheet is flat (a pillowed patch of a face, docs/sheets.md).
   bool internal_sheets = true;
+  // Splits along a primal cycle when the elimination is stuck; max_depth = 0 turns them off.
+  DecompositionOptions decomposition;
   int smoothing_iterations = 500;  // barycentric sweeps before the optimizer
   bool optimize = true;
   OptimizeOptions optimizer;
@@ -128,7 +137,8 @@ struct SheetMeshReport {
   int eliminations = 0;         // steps
   int eliminations_single = 0;  // steps of one chord
   int eliminations_k_step = 0;  // steps of k >= 2 chords
-  int chords_eliminated = 0;    // chords - 3 for a complete scheme
+  int chords_eliminated = 0;    // chords - 3 for a complete scheme without decomposition
+  int decompositions = 0;       // splits along a primal cycle (nested ones included)
   int external_sheets = 0;
   int internal_sheets = 0;
   int hexes = 0;
@@ -140,7 +150,8 @@ struct SheetMeshReport {
   QualitySummary quality;   // of the final mesh (node degrees inside)
 };
 
-// Steps 1 to 3.
+// Steps 1 to 3, with decomposition where the elimination is stuck. The counts of eliminations and sheets
+// add up over the parts of a decomposition.
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
                                   SheetMeshReport* report = nullptr);
 

@@ -190,6 +190,16 @@ inline QuadSurface no_scheme_surface() {
   return s;
 }
 
+// The same ball with the two merged vertices moved to the middle of their collapsed diagonals, so that every
+// quad is convex (no_scheme_surface() has quads with three collinear corners: a hex on one of them has a
+// corner Jacobian of 0, inverted whatever the interior).
+inline QuadSurface no_scheme_convex_surface() {
+  QuadSurface s = no_scheme_surface();
+  s.vertices[vertex_at(s, {1, 2, 2})] = {1.5, 1.5, 2};
+  s.vertices[vertex_at(s, {2, 2, 0})] = {1.5, 1.5, 0};
+  return s;
+}
+
 // Quads as vertex-id cycles rotated to start at their smallest id, sorted: equal for equal quad sets with
 // the same orientation.
 inline std::vector<std::array<int, 4>> canonical_quads(const std::vector<std::array<int, 4>>& quads) {

@@ -10,6 +10,7 @@
 #include "mesher/elimination_feasibility.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/primal_cycle_decomposition.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 #include "tests/quad_test_surfaces.h"
@@ -279,6 +280,124 @@ TEST(CycleElimination, NoSchemeIsARunErrorNamingTheChords) {
   }
 }
 
+// Decomposition along a primal cycle (mesher/primal_cycle_decomposition.h). On the 2 x 2 x 2 block the most
+// balanced of the shortest cycles is an equator (8 edges, 12 quads on either side); a ladder disk (3 quads)
+// would leave odd parts, so the disk is the fan of 4 quads around one new vertex at the centroid, and each
+// part is the surface of a 2 x 2 x 1 block.
+TEST(CycleElimination, DecompositionSplitsABlockAtAnEquatorWithAFan) {
+  const QuadSurface s = test::block_surface(2, 2, 2);
+  const int n = static_cast<int>(s.vertices.size());
+  int handed = 0;
+  const DecompositionSearch search = search_primal_cycle_splits(s, {}, [&](const PrimalCycleSplit& split) {
+    ++handed;
+    EXPECT_EQ(split.cycle.size(), 8u);
+    int planes = 0;  // coordinates equal to 1 on the whole cycle
+    for (int c = 0; c < 3; ++c)
+      planes +=
+          std::all_of(split.cycle.begin(), split.cycle.end(), [&](int v) { return s.vertices[v][c] == 1.0; });
+    EXPECT_EQ(planes, 1);
+    EXPECT_EQ(split.side_quads, (std::array<int, 2>{12, 12}));
+    EXPECT_EQ(split.disk.size(), 4u);
+    EXPECT_EQ(split.disk_vertices, 1);
+    EXPECT_EQ(split.disk_positions, (std::vector<Vec3>{{1.0, 1.0, 1.0}}));
+    for (int p = 0; p < 2; ++p) {
+      const QuadSurface& part = split.parts[p];
+      EXPECT_TRUE(check_quad_surface(part, "").usable());
+      EXPECT_EQ(part.quads.size(), 16u);
+      EXPECT_EQ(part.vertices.size(), 18u);
+      EXPECT_EQ(chord_count(part), 5);
+      // The part in split ids: its side's input quads plus the disk, reversed for part 1.
+      std::vector<std::array<int, 4>> quads;
+      for (auto q : part.quads) {
+        for (int& v : q) v = split.ids[p][v];
+        quads.push_back(q);
+      }
+      for (std::size_t v = 0; v < part.vertices.size(); ++v) {
+        const int id = split.ids[p][v];
+        EXPECT_EQ(part.vertices[v], id < n ? s.vertices[id] : split.disk_positions[id - n]);
+      }
+      std::vector<std::array<int, 4>> expected;
+      for (const auto& q : split.disk)
+        expected.push_back(p == 0 ? q : std::array<int, 4>{q[3], q[2], q[1], q[0]});
+      for (const auto& q : s.quads)
+        if (std::find(quads.begin(), quads.end(), q) != quads.end()) expected.push_back(q);
+      EXPECT_EQ(test::canonical_quads(quads), test::canonical_quads(expected));
+    }
+    return true;
+  });
+  EXPECT_TRUE(search.accepted);
+  EXPECT_EQ(search.splits, 1);
+  EXPECT_EQ(handed, 1);
+}
+
+// The 30-quad ball without an elimination scheme meshes through one decomposition in every order: an
+// 8-cycle with 15 quads on either side, spanned by a ladder of 3 quads, leaves two 18-quad parts that
+// eliminate (4 single eliminations in all). The result must be conforming (extract_boundary() throws
+// otherwise), bounded by exactly the input, and every hex must have 8 distinct vertices. The 10 hexes have
+// no interior vertex, so the embedding cannot move anything: 6 are inverted on both geometries (the
+// collapsed quads of no_scheme_surface() have three collinear corners, the convex version keeps 6 too),
+// which the command reports and refuses to write without --allow-invalid.
+TEST(CycleElimination, StuckSurfaceMeshesByDecomposition) {
+  for (const QuadSurface& s : {test::no_scheme_surface(), test::no_scheme_convex_surface()}) {
+    for (EliminationOrder order :
+         {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
+      SCOPED_TRACE(elimination_order_name(order));
+      SheetMeshOptions options;
+      options.elimination.order = order;
+      SheetMeshReport r;
+      const HexMesh mesh = mesh_by_cycle_elimination(s, options, &r);
+      expect_boundary_equals_input(mesh, s);
+      ASSERT_EQ(mesh.hexes.size(), 10u);
+      for (const auto& hex : mesh.hexes) {
+        auto sorted = hex;
+        std::sort(sorted.begin(), sorted.end());
+        EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+      }
+      EXPECT_EQ(r.decompositions, 1);
+      EXPECT_EQ(r.hexes, 10);
+      EXPECT_EQ(r.interior_vertices, 0);
+      EXPECT_EQ(r.eliminations, 4);
+      EXPECT_EQ(r.eliminations_single, 4);
+      EXPECT_EQ(r.chords_eliminated, 4);
+      EXPECT_EQ(r.external_sheets + r.internal_sheets, 4);
+      EXPECT_EQ(r.quality.inverted, 6);
+    }
+  }
+  // A surface with a scheme is never decomposed.
+  SheetMeshReport block;
+  mesh_by_cycle_elimination(test::block_surface(3, 2, 2), {}, &block);
+  EXPECT_EQ(block.decompositions, 0);
+}
+
+// Where decomposition fails as well (here: only 4-cycles allowed, and every 4-cycle of this ball bounds a
+// single quad), the RunError still names the chords, says what was tried and ends with the advice; with
+// decomposition off it is the elimination's own message.
+TEST(CycleElimination, FailedDecompositionIsARunError) {
+  const QuadSurface s = test::no_scheme_surface();
+  SheetMeshOptions options;
+  options.decomposition.max_cycle_length = 4;
+  try {
+    mesh_by_cycle_elimination(s, options);
+    ADD_FAILURE() << "no RunError";
+  } catch (const RunError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("cycle elimination is stuck"), std::string::npos) << m;
+    EXPECT_NE(m.find("chord 0 (length"), std::string::npos) << m;
+    EXPECT_NE(m.find("Decomposition along a primal cycle did not help either"), std::string::npos) << m;
+    EXPECT_NE(m.find("even length up to 4 gave 0 splits"), std::string::npos) << m;
+    EXPECT_EQ(m.substr(m.size() - 13), "--method grid") << m;
+  }
+  options.decomposition.max_depth = 0;
+  try {
+    mesh_by_cycle_elimination(s, options);
+    ADD_FAILURE() << "no RunError";
+  } catch (const RunError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("cycle elimination is stuck"), std::string::npos) << m;
+    EXPECT_EQ(m.find("Decomposition"), std::string::npos) << m;
+  }
+}
+
 // Many generated balls: every usable polycube of a 3 x 3 x 2 cell block (cell subsets from a fixed
 // pseudo-random sequence) in every order, with internal sheets. The complex must be conforming, every hex
 // must have 8 distinct vertices, and its boundary must be the input exactly; a complete scheme eliminates
@@ -376,14 +495,26 @@ TEST(MeshSheetsCli, WritesTheMeshAndRejectsBadSurfaces) {
   EXPECT_NE(bad.err.find("not a ball: genus 1"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/t.vtu"));
 
+  // The surface without a scheme meshes by decomposition; 6 of its 10 hexes stay inverted, so the mesh is
+  // written only with --allow-invalid.
   write_quad_obj(dir + "/stuck.obj", test::no_scheme_surface());
   const auto stuck = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/stuck.obj",
                                         "--order", "look-ahead", "-o", dir + "/s.vtu"});
   EXPECT_EQ(stuck.exit_code, 1);
-  EXPECT_NE(stuck.err.find("stuck after 0 eliminations"), std::string::npos) << stuck.err;
-  EXPECT_NE(stuck.err.find("chord 0 (length"), std::string::npos) << stuck.err;
-  EXPECT_NE(stuck.err.find("--method grid"), std::string::npos) << stuck.err;
+  EXPECT_NE(stuck.out.find("1 decompositions, 10 hexes"), std::string::npos) << stuck.out;
+  EXPECT_NE(stuck.err.find("6 hexes stay inverted"), std::string::npos) << stuck.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/s.vtu"));
+  const auto split = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/stuck.obj",
+                                        "-o", dir + "/s.vtu", "--allow-invalid", "--json"});
+  ASSERT_EQ(split.exit_code, 0) << split.err;
+  const auto js = nlohmann::json::parse(split.out);
+  EXPECT_EQ(js["decompositions"], 1);
+  EXPECT_EQ(js["hexes"], 10);
+  EXPECT_EQ(js["eliminations_single"], 4);
+  EXPECT_EQ(js["quality"]["inverted"], 6);
+  const HexMesh written = read_vtu(dir + "/s.vtu");
+  EXPECT_EQ(written.hexes.size(), 10u);
+  EXPECT_EQ(j["decompositions"], 0);
 }
 
 }  // namespace
