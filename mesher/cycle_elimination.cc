@@ -43,27 +43,8 @@ struct Step {
 
 // Edge-connected components of the quads outside the strip; comp[q] = -1 for strip quads.
 int components(const QuadEdges& qe, const std::vector<char>& strip, std::vector<int>& comp) {
-  const int nq = static_cast<int>(strip.size());
-  comp.assign(static_cast<std::size_t>(nq), -1);
-  int count = 0;
-  std::vector<int> queue;
-  for (int s = 0; s < nq; ++s) {
-    if (strip[s] || comp[s] >= 0) continue;
-    queue.assign(1, s);
-    comp[s] = count;
-    while (!queue.empty()) {
-      const int q = queue.back();
-      queue.pop_back();
-      for (int e : qe.quad_edges[q])
-        for (const auto& [r, local] : qe.edge_quads[e])
-          if (!strip[r] && comp[r] < 0) {
-            comp[r] = count;
-            queue.push_back(r);
-          }
-    }
-    ++count;
-  }
-  return count;
+  return quad_components(
+      qe, [&strip](int q) { return !strip[q]; }, [](int) { return true; }, comp);
 }
 
 // The linear part of the feasibility test of one chord: distinct rung endpoints (both rails are disjoint
@@ -152,33 +133,18 @@ bool k_step(const std::vector<Quad>& quads, const QuadEdges& qe, const std::vect
     out.strip_quads += chords[p->chord].length();
   }
   std::sort(out.chords.begin(), out.chords.end());
-  int first = -1;
   for (int q = 0; q < nq; ++q) {
     bool in = true;
     for (std::size_t i = 0; i < k && in; ++i) in = parts[i]->side[q] == s[i];
     if (!in) continue;
     out.on_side[q] = 1;
     ++out.side_quads;
-    if (first < 0) first = q;
   }
-  if (first < 0) return false;
-  // (2) Q edge-connected.
-  std::vector<char> reached(static_cast<std::size_t>(nq), 0);
-  std::vector<int> queue{first};
-  reached[first] = 1;
-  int count = 0;
-  while (!queue.empty()) {
-    const int q = queue.back();
-    queue.pop_back();
-    ++count;
-    for (int e : qe.quad_edges[q])
-      for (const auto& [r, local] : qe.edge_quads[e])
-        if (out.on_side[r] && !reached[r]) {
-          reached[r] = 1;
-          queue.push_back(r);
-        }
-  }
-  if (count != out.side_quads) return false;
+  // (2) Q non-empty and edge-connected.
+  std::vector<int> component;
+  if (quad_components(
+          qe, [&out](int q) { return out.on_side[q] != 0; }, [](int) { return true; }, component) != 1)
+    return false;
   // (3) Q union Q_i larger than Q.
   for (std::size_t i = 0; i < k; ++i)
     if (parts[i]->size[s[i]] <= out.side_quads) return false;

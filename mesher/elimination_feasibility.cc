@@ -46,22 +46,9 @@ bool is_polyhedral_ball(const std::vector<std::array<int, 4>>& quads) {
     if (list.size() != 2) return false;
     if (quads[list[0][0]][list[0][1]] == quads[list[1][0]][list[1][1]]) return false;
   }
-  std::vector<char> reached(static_cast<std::size_t>(nq), 0);
-  std::vector<int> queue{0};
-  reached[0] = 1;
-  int count = 0;
-  while (!queue.empty()) {
-    const int q = queue.back();
-    queue.pop_back();
-    ++count;
-    for (int e : qe.quad_edges[q])
-      for (const auto& [r, local] : qe.edge_quads[e])
-        if (!reached[r]) {
-          reached[r] = 1;
-          queue.push_back(r);
-        }
-  }
-  if (count != nq) return false;
+  std::vector<int> component;
+  const auto every = [](int) { return true; };
+  if (quad_components(qe, every, every, component) != 1) return false;
   // Vertex -> quads incidence (compressed rows), also counting the used vertices.
   std::vector<int> start(static_cast<std::size_t>(max_id) + 2, 0);
   for (const auto& q : quads)

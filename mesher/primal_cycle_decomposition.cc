@@ -132,31 +132,12 @@ DecompositionSearch search_primal_cycle_splits(const QuadSurface& surface,
   };
   // The quads on either side of a cycle: side[q] = 0 or 1 (the side of quad 0 is 0); false unless two.
   std::vector<char> cut(qe.edges.size(), 0);
-  std::vector<int> queue;
   auto sides_of = [&](const std::vector<int>& cycle, std::vector<int>& side) {
     const int length = static_cast<int>(cycle.size());
     std::fill(cut.begin(), cut.end(), 0);
     for (int i = 0; i < length; ++i) cut[edge_id(cycle[i], cycle[(i + 1) % length])] = 1;
-    side.assign(static_cast<std::size_t>(nq), -1);
-    int sides = 0;
-    for (int q0 = 0; q0 < nq; ++q0) {
-      if (side[q0] >= 0) continue;
-      side[q0] = sides;
-      queue.assign(1, q0);
-      while (!queue.empty()) {
-        const int q = queue.back();
-        queue.pop_back();
-        for (int e : qe.quad_edges[q])
-          if (!cut[e])
-            for (const auto& [r, local] : qe.edge_quads[e])
-              if (side[r] < 0) {
-                side[r] = sides;
-                queue.push_back(r);
-              }
-      }
-      ++sides;
-    }
-    return sides == 2;
+    return quad_components(
+               qe, [](int) { return true; }, [&cut](int e) { return !cut[e]; }, side) == 2;
   };
   // (smaller side, cycle): the most balanced first, then the shorter.
   std::vector<std::pair<int, std::vector<int>>> candidates;

@@ -38,6 +38,35 @@ struct QuadEdges {
 
 QuadEdges build_quad_edges(const std::vector<std::array<int, 4>>& quads);
 
+// Edge-connected components of the quads q for which in_set(q) holds, joined only across the edges e for
+// which crossable(e) holds: component[q] = its number (numbered in the order of their lowest quad), -1 for
+// quads outside the set. Returns the number of components. O(F).
+template <class InSet, class Crossable>
+int quad_components(const QuadEdges& qe, InSet in_set, Crossable crossable, std::vector<int>& component) {
+  const int nq = static_cast<int>(qe.quad_edges.size());
+  component.assign(static_cast<std::size_t>(nq), -1);
+  int count = 0;
+  std::vector<int> stack;
+  for (int s = 0; s < nq; ++s) {
+    if (component[s] >= 0 || !in_set(s)) continue;
+    component[s] = count;
+    stack.assign(1, s);
+    while (!stack.empty()) {
+      const int q = stack.back();
+      stack.pop_back();
+      for (int e : qe.quad_edges[q])
+        if (crossable(e))
+          for (const auto& [r, local] : qe.edge_quads[e])
+            if (component[r] < 0 && in_set(r)) {
+              component[r] = count;
+              stack.push_back(r);
+            }
+    }
+    ++count;
+  }
+  return count;
+}
+
 struct Chord {
   std::vector<int> quads;           // crossed quads in order (a quad crossed twice appears twice)
   std::vector<int> edges;           // edges[i] is where the chord enters quads[i]
