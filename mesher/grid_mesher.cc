@@ -123,7 +123,8 @@ void classify(Selection& s, const SurfaceProjector& surface) {
 // that reach well into the solid: then a plate or a neck thinner than a cell keeps a sheet of cells (which
 // the pillow layer pulls below the surface) instead of vanishing from the core. Distances are computed for
 // the inside cells within a few cells of an outside cell when the margin is positive (deeper cells are far
-// enough by construction), and for every outside cell when it is negative.
+// enough by construction), and, when it is negative, for the outside cells whose centre lies within
+// -margin * h of a triangle's bounding box (the others cannot qualify).
 void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
   const Grid& g = s.grid;
   const long nc = g.cells();
@@ -142,9 +143,29 @@ void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
           near[g.cell(a, b, e)] = 1;
         }
   }
+  // For a negative margin, only the outside cells whose centre lies in the bounding box of a triangle
+  // widened by -margin * h can be close enough: the others are skipped without a distance query.
+  std::vector<char> candidate;
+  if (margin < 0.0) {
+    candidate.assign(nc, 0);
+    const double r = -margin * g.h * (1.0 + 1e-9) + 1e-12 * g.h;
+    const TriSurface& t = surface.surface();
+    for (const auto& tri : t.triangles) {
+      int from[3], to[3];
+      for (int a = 0; a < 3; ++a) {
+        double lo = kInf, hi = -kInf;
+        for (int v : tri) lo = std::min(lo, t.vertices[v][a]), hi = std::max(hi, t.vertices[v][a]);
+        from[a] = std::max(0, int(std::ceil((lo - r - g.origin[a]) / g.h - 0.5)));
+        to[a] = std::min(g.n[a] - 1, int(std::floor((hi + r - g.origin[a]) / g.h - 0.5)));
+      }
+      for (int k = from[2]; k <= to[2]; ++k)
+        for (int j = from[1]; j <= to[1]; ++j)
+          for (int i = from[0]; i <= to[0]; ++i) candidate[g.cell(i, j, k)] = 1;
+    }
+  }
   s.selected.assign(nc, 0);
   for (long c = 0; c < nc; ++c) {
-    if (!s.inside[c] && margin >= 0.0) continue;
+    if (!s.inside[c] && (margin >= 0.0 || !candidate[c])) continue;
     // Every inside cell qualifies for a margin <= 0 (its distance is positive), without a distance query.
     if (s.inside[c] && margin <= 0.0) {
       s.selected[c] = 1;
@@ -560,14 +581,19 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   for (const Vec3& p : surface.vertices)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
 
-  // Where a thin part cuts through a cell decides how its hexes look, so a grid can leave a tangle that the
-  // untangler cannot undo. Then the grid is shifted by half a cell, and by a quarter, and the first valid
-  // mesh is kept (or the one with the fewest inverted hexes, then the best minimum scaled Jacobian).
+  // Where a thin part cuts through a cell decides how its hexes look: a grid can leave a tangle that the
+  // untangler cannot undo, and the worst hexes of valid meshes differ widely between grid positions. So
+  // the grid is also shifted by half a cell and by a quarter, and the mesh with the fewest inverted hexes,
+  // then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept.
   const double shifts[] = {0.0, 0.5, 0.25};
+  const int grids = std::clamp(options.grids, 1, 3);
+  auto worst_measure = [](const QualitySummary& q) {
+    return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
+  };
   GridMeshReport report;
   HexMesh mesh;
   Selection kept;
-  for (int attempt = 0; attempt < 3; ++attempt) {
+  for (int attempt = 0; attempt < grids; ++attempt) {
     const auto t_attempt = std::chrono::steady_clock::now();
     GridMeshReport r;
     // The cell size: secant steps on log(total hexes) against log(h), where total = core cells + core
@@ -618,13 +644,12 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     const QualitySummary& q = r.optimize.phases.back().quality;
     const QualitySummary* kept_q = attempt > 0 ? &report.optimize.phases.back().quality : nullptr;
     if (!kept_q || q.inverted < kept_q->inverted ||
-        (q.inverted == kept_q->inverted && q.scaled_jacobian.min > kept_q->scaled_jacobian.min)) {
+        (q.inverted == kept_q->inverted && worst_measure(q) > worst_measure(*kept_q))) {
       report = std::move(r);
       mesh = std::move(m);
       kept = std::move(best);
     }
     report.attempts = attempt + 1;
-    if (report.optimize.inverted == 0) break;
   }
 
   const auto t0 = std::chrono::steady_clock::now();

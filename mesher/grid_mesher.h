@@ -18,12 +18,13 @@
 //   3. pillow layer: core boundary vertices outside or near the surface are pulled below it, then each gets
 //      a copy on the surface (along the vertex normal, or the closest point), and each core boundary quad one
 //      hex to it, so no hex has two boundary faces;
-//   4. optimize_hex_mesh with the boundary sliding on the surface;
-//   5. when hexes stay inverted, steps 1-4 again on the grid shifted by half a cell, then by a quarter; the
-//      first valid mesh is kept (or the one with the fewest inverted hexes).
+//   4. optimize_hex_mesh with the boundary sliding on the surface, resting nodes skipped, and its
+//      worst-element pass (hexes with a scaled Jacobian or 3 / kappa below 0.5);
+//   5. steps 1-4 again on the grid shifted by half a cell, then by a quarter; the mesh with the fewest
+//      inverted hexes, then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept.
 // Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
-// (for the default negative margin) per trial size; the optimizer dominates. A shifted grid (step 5)
-// repeats everything.
+// near a surface triangle (for the default negative margin) per trial size; the optimizer dominates. Each
+// grid of step 5 repeats everything.
 // Deterministic: same surface and options, same mesh (bit for bit).
 #pragma once
 
@@ -44,7 +45,18 @@ struct GridMeshOptions {
   // cells whose centre lies up to -margin * h outside (cells reaching into the solid), so that parts
   // thinner than a cell stay in the core.
   double margin = -0.4;
-  OptimizeOptions optimize;
+  // Grids tried, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3). The mesh with
+  // the fewest inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
+  int grids = 3;
+  // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass.
+  OptimizeOptions optimize = [] {
+    OptimizeOptions o;
+    o.reactivate = 0.01;
+    o.worst_element_threshold = 0.5;
+    o.worst_element_reach = 0.8;
+    o.scaled_jacobian_sweeps = 3;
+    return o;
+  }();
 };
 
 // A region of the surface that the mesh does not reach (a part too thin for the cell size, or a core
@@ -68,7 +80,7 @@ struct MeshFidelity {
 };
 
 struct GridMeshReport {
-  int attempts = 1;           // grids tried (shifted when a grid left inverted hexes), the last one kept
+  int attempts = 1;           // grids tried (GridMeshOptions::grids), the best one kept
   double cell_size = 0;       // h, mm (this and the fields below describe the kept grid)
   std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;

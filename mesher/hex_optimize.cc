@@ -279,6 +279,145 @@ bool untangle_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sl
   return moved;
 }
 
+// The two measures of corner k of hex e that the worst-element pass raises, both 1 for a cube corner and
+// at most 1: the scaled Jacobian s = det A / (|a| |b| |c|) and q = 3 / kappa(A) (0 where det A <= 0), with
+// their gradients with respect to the position of node v (one of the corner's four nodes).
+void corner_measures(const HexMesh& mesh, int e, int k, int v, double& s, Vec3& gs, double& q, Vec3& gq) {
+  const auto& h = mesh.hexes[e];
+  const int* nb = kHexCornerNeighbours[k];
+  const Vec3& x = mesh.vertices[h[k]];
+  const Vec3 a = sub(mesh.vertices[h[nb[0]]], x), b = sub(mesh.vertices[h[nb[1]]], x),
+             c = sub(mesh.vertices[h[nb[2]]], x);
+  const Vec3 bc = cross(b, c), ca = cross(c, a), ab = cross(a, b);
+  const double aa = dot(a, a), bb = dot(b, b), cc = dot(c, c);
+  const double len = std::sqrt(aa * bb * cc);
+  s = len > 0.0 ? dot(a, bc) / len : 0.0;
+  // ds = d(det) / len - s (sum over the changed columns u of u . du / |u|^2).
+  if (!(len > 0.0))
+    gs = {0, 0, 0};
+  else if (h[k] == v)
+    gs = add(scale(add(add(bc, ca), ab), -1.0 / len),
+             scale(add(add(scale(a, 1.0 / aa), scale(b, 1.0 / bb)), scale(c, 1.0 / cc)), s));
+  else if (h[nb[0]] == v)
+    gs = sub(scale(bc, 1.0 / len), scale(a, s / aa));
+  else if (h[nb[1]] == v)
+    gs = sub(scale(ca, 1.0 / len), scale(b, s / bb));
+  else
+    gs = sub(scale(ab, 1.0 / len), scale(c, s / cc));
+  // q = 3 f^(-1/2) with f = kappa^2, so dq = -1.5 f^(-3/2) df.
+  double f;
+  Vec3 ga, gb, gc;
+  if (!corner_energy(a, b, c, f, ga, gb, gc)) {
+    q = 0.0;
+    gq = {0, 0, 0};
+    return;
+  }
+  q = 3.0 / std::sqrt(f);
+  const Vec3 df = h[k] == v       ? scale(add(add(ga, gb), gc), -1.0)
+                  : h[nb[0]] == v ? ga
+                  : h[nb[1]] == v ? gb
+                                  : gc;
+  gq = scale(df, -0.5 * q / f);
+}
+
+// The smallest scaled Jacobian and the smallest 3 / kappa over the given corners.
+void corner_measures_min(const HexMesh& mesh, const std::vector<CornerRef>& corners, int v, double& s_min,
+                         double& q_min) {
+  s_min = q_min = kInf;
+  for (const CornerRef& c : corners) {
+    double s, q;
+    Vec3 gs, gq;
+    corner_measures(mesh, c.hex, c.corner, v, s, gs, q, gq);
+    s_min = std::min(s_min, s);
+    q_min = std::min(q_min, q);
+  }
+}
+
+// One worst-element visit of node v: ascent on the soft minimum S(p) = -(1/mu) log sum exp(-mu m_i(p))
+// of the measures m_i of the corners that depend on p (scaled Jacobian and 3 / kappa with `with_kappa`,
+// else the scaled Jacobian alone), with the untangler's damped Gauss-Newton model of its Hessian. A step
+// is accepted only when the true minimum of the m_i grows and no corner's 3 / kappa falls below the
+// smaller of its old minimum and `q_floor`. A sliding node steps in its tangent plane, is projected back,
+// and never steps farther from `home` than `reach` or than it already is. Returns true when the node moved.
+bool raise_worst_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sliding,
+                      const SurfaceProjector* surface, const Vec3& home, double reach, bool with_kappa,
+                      double q_floor, std::vector<CornerRef>& corners) {
+  corners_of_node(mesh, adj, v, corners);
+  if (corners.empty()) return false;
+  const double mu = 30.0;
+  bool moved = false;
+  for (int iter = 0; iter < 4; ++iter) {
+    const std::size_t n = corners.size();
+    std::vector<double> m;
+    std::vector<Eigen::Vector3d> g;
+    double mmin = kInf, qmin = kInf;
+    for (std::size_t i = 0; i < n; ++i) {
+      double sj, q;
+      Vec3 gs, gq;
+      corner_measures(mesh, corners[i].hex, corners[i].corner, v, sj, gs, q, gq);
+      m.push_back(sj);
+      g.push_back(Eigen::Vector3d(gs[0], gs[1], gs[2]) * h);  // per unit of the edge length
+      if (with_kappa) {
+        m.push_back(q);
+        g.push_back(Eigen::Vector3d(gq[0], gq[1], gq[2]) * h);
+      }
+      mmin = std::min(mmin, with_kappa ? std::min(sj, q) : sj);
+      qmin = std::min(qmin, q);
+    }
+    const double q_limit = std::min(qmin, q_floor);
+    double z = 0.0;
+    std::vector<double> w(m.size());
+    for (std::size_t i = 0; i < m.size(); ++i) z += (w[i] = std::exp(-mu * (m[i] - mmin)));
+    Eigen::Vector3d grad = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < m.size(); ++i) grad += (w[i] / z) * g[i];
+    Eigen::Matrix3d neg_hess = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < m.size(); ++i) neg_hess += (w[i] / z) * g[i] * g[i].transpose();
+    neg_hess = mu * (neg_hess - grad * grad.transpose());
+    Eigen::Matrix3d basis = Eigen::Matrix3d::Identity();
+    int dims = 3;
+    SurfacePoint here;
+    if (sliding) {
+      here = surface->closest(mesh.vertices[v]);
+      Vec3 t1, t2;
+      tangent_frame(here.normal, t1, t2);
+      basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
+      basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
+      dims = 2;
+    }
+    const Eigen::MatrixXd b = basis.leftCols(dims);
+    const Eigen::VectorXd rg = b.transpose() * grad;
+    if (!(rg.norm() > 0.0)) break;
+    Eigen::MatrixXd rh = b.transpose() * neg_hess * b;
+    const double damping = 1e-3 * (rh.trace() / dims) + 1e-12 + 1e-1 * rg.norm();
+    rh += damping * Eigen::MatrixXd::Identity(dims, dims);
+    Eigen::VectorXd step = rh.ldlt().solve(rg);
+    if (!step.allFinite() || step.dot(rg) <= 0) step = rg;
+    Eigen::Vector3d dp = h * (b * step);  // back to length units
+    const double max_len = 0.1 * h;
+    if (dp.norm() > max_len) dp *= max_len / dp.norm();
+
+    const Vec3 old = mesh.vertices[v];
+    bool accepted = false;
+    for (int bt = 0; bt < 8 && !accepted; ++bt, dp *= 0.5) {
+      Vec3 trial = {old[0] + dp[0], old[1] + dp[1], old[2] + dp[2]};
+      if (sliding) {
+        trial = surface->closest(trial, here).point;
+        if (norm(sub(trial, home)) > std::max(reach, norm(sub(old, home)))) continue;
+      }
+      mesh.vertices[v] = trial;
+      double s_new, q_new;
+      corner_measures_min(mesh, corners, v, s_new, q_new);
+      accepted = (with_kappa ? std::min(s_new, q_new) : s_new) > mmin + 1e-6 && q_new >= q_limit;
+    }
+    if (!accepted) {
+      mesh.vertices[v] = old;
+      break;
+    }
+    moved = true;
+  }
+  return moved;
+}
+
 std::vector<char> inverted_mask(const HexMesh& mesh, int* count) {
   std::vector<char> inv(mesh.hexes.size(), 0);
   int c = 0;
@@ -419,6 +558,10 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
   // the local edge length. Without it, nodes at a thin tip (the coronoid process) slide away from the tip,
   // because a blunter boundary has better shaped hexes, and the mesh silently loses the tip.
   const std::vector<Vec3> anchor = mesh.vertices;
+  // The closest surface point of each sliding node (its tangent plane), kept up to date as it moves.
+  std::vector<SurfacePoint> foot(nv);
+  for (std::size_t v = 0; v < nv; ++v)
+    if (sliding[v]) foot[v] = surface->closest(mesh.vertices[v]);
   // The local objective of node v at position p: the squared condition numbers of its corners plus the
   // tether, with the gradient with respect to p; +infinity when a corner is not positively oriented.
   auto local = [&](int v, const Vec3& p, Vec3* grad) {
@@ -469,9 +612,10 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
       return 0.0;
     }
     Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, sliding[v] ? 2 : 3);
+    const SurfacePoint& here = foot[v];
     if (sliding[v]) {
       Vec3 t1, t2;
-      tangent_frame(surface->closest(p0).normal, t1, t2);
+      tangent_frame(here.normal, t1, t2);
       basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
       basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
     } else {
@@ -504,9 +648,14 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
     for (int bt = 0; bt < 12; ++bt, t *= 0.5) {
       const Eigen::Vector3d dp = t * (basis * step);
       Vec3 trial{p0[0] + dp[0], p0[1] + dp[1], p0[2] + dp[2]};
-      if (sliding[v]) trial = surface->closest(trial).point;
+      SurfacePoint projected;
+      if (sliding[v]) {
+        projected = surface->closest(trial, here);
+        trial = projected.point;
+      }
       const double f = local(v, trial, nullptr);
       if (f < f0) {
+        if (sliding[v]) foot[v] = projected;
         decrease = f0 - f;
         return norm(sub(trial, p0)) / h[v];
       }
@@ -517,13 +666,22 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
 
   Progress progress("condition number optimization");
   int sweeps = 0;
+  std::vector<char> active(nv, 1);
   while (sweeps < options.max_iterations) {
     double max_move = 0.0, decrease = 0.0;
     for (std::size_t v = 0; v < nv; ++v) {
-      if (!movable[v] || corners[v].empty()) continue;
+      if (!movable[v] || corners[v].empty() || !active[v]) continue;
       double d = 0.0;
-      max_move = std::max(max_move, relax(static_cast<int>(v), d));
+      const double move = relax(static_cast<int>(v), d);
+      max_move = std::max(max_move, move);
       decrease += d;
+      // A node that hardly moved rests until a node of its hexes moves (its local objective then changed).
+      if (options.reactivate > 0.0) {
+        active[v] = 0;
+        if (move > options.reactivate)
+          for (int i = adj.hex_start[v]; i < adj.hex_start[v + 1]; ++i)
+            for (int w : mesh.hexes[adj.hex_list[i]]) active[w] = 1;
+      }
     }
     ++sweeps;
     progress.update(double(sweeps) / options.max_iterations,
@@ -532,6 +690,70 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
     // only the node's own terms), so the energy is tracked without re-evaluating it.
     energy -= decrease;
     if (max_move < options.tolerance || decrease < 1e-5 * energy) break;
+  }
+  progress.finish(std::to_string(sweeps) + " sweeps");
+  return sweeps;
+}
+
+int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
+                           const SurfaceProjector* surface, const OptimizeOptions& options,
+                           const std::vector<Vec3>* home_in) {
+  if (!(options.worst_element_threshold > 0.0)) return 0;
+  int inverted = 0;
+  inverted_mask(mesh, &inverted);
+  if (inverted > 0) return 0;
+  const Adjacency adj(mesh);
+  const std::vector<double> h = local_edge_length(mesh, adj);
+  const std::vector<Vec3> home = home_in ? *home_in : mesh.vertices;
+  // Per hex the measure of the stage (the smaller of the scaled Jacobian and 3 / kappa, or the scaled
+  // Jacobian alone), and the mesh's smallest 3 / kappa.
+  std::vector<double> worst(mesh.hexes.size());
+  double q_floor = kInf;
+  auto measure = [&](bool with_kappa) {
+    q_floor = kInf;
+    for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
+      Vec3 p[8];
+      for (int i = 0; i < 8; ++i) p[i] = mesh.vertices[mesh.hexes[e][i]];
+      const HexQuality q = hex_quality(p);
+      worst[e] = with_kappa ? std::min(q.scaled_jacobian, 3.0 / q.condition) : q.scaled_jacobian;
+      q_floor = std::min(q_floor, 3.0 / q.condition);
+    }
+  };
+  std::vector<CornerRef> corners;
+  Progress progress("worst elements");
+  int sweeps = 0;
+  // The first stage raises both measures of the hexes below the threshold; the second the scaled Jacobian
+  // of every hex, with no corner's 3 / kappa falling below the mesh's smallest.
+  for (int stage = 0; stage < 2; ++stage) {
+    const bool with_kappa = stage == 0;
+    const double threshold = with_kappa ? options.worst_element_threshold : 1.0;
+    const int max_sweeps = with_kappa ? options.worst_element_sweeps : options.scaled_jacobian_sweeps;
+    measure(with_kappa);
+    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+      // Visit the nodes of the hexes below the threshold, worst hex first (ties by index).
+      std::vector<int> bad;
+      for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+        if (worst[e] < threshold) bad.push_back(static_cast<int>(e));
+      if (bad.empty()) break;
+      std::stable_sort(bad.begin(), bad.end(), [&](int a, int b) { return worst[a] < worst[b]; });
+      std::vector<char> seen(mesh.vertices.size(), 0);
+      bool moved = false;
+      for (int e : bad)
+        for (int v : mesh.hexes[e]) {
+          if (seen[v] || !movable[v]) continue;
+          seen[v] = 1;
+          const bool slides = surface != nullptr && !sliding.empty() && sliding[v] != 0;
+          moved = raise_worst_node(mesh, adj, v, h[v], slides, surface, home[v],
+                                   options.worst_element_reach * h[v], with_kappa, with_kappa ? 0.0 : q_floor,
+                                   corners) ||
+                  moved;
+        }
+      ++sweeps;
+      measure(with_kappa);
+      progress.update(double(sweep + 1) / max_sweeps,
+                      "stage " + std::to_string(stage + 1) + ", sweep " + std::to_string(sweep + 1));
+      if (!moved) break;
+    }
   }
   progress.finish(std::to_string(sweeps) + " sweeps");
   return sweeps;
@@ -566,6 +788,7 @@ OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface,
   report.phases.push_back({"untangled", summarize_quality(mesh), seconds_since(t0)});
 
   t0 = std::chrono::steady_clock::now();
+  const std::vector<Vec3> entry = mesh.vertices;
   for (int repeat = 0; repeat < options.max_repeats && report.iterations < options.max_iterations; ++repeat) {
     int rounds = 0;
     OptimizeOptions remaining = options;
@@ -577,6 +800,7 @@ OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface,
     if (inverted == 0) break;
     report.untangle_sweeps += untangle(mesh, movable, sliding, surface, options.max_untangle_sweeps);
   }
+  report.worst_element_sweeps = improve_worst_elements(mesh, movable, sliding, surface, options, &entry);
   report.phases.push_back({"final", summarize_quality(mesh), seconds_since(t0)});
   report.inverted = report.phases.back().quality.inverted;
   valid = inverted_mask(mesh, nullptr);

@@ -19,10 +19,20 @@
 //      plane and are projected back onto the surface at every trial, tethered to where they started so that
 //      they do not abandon thin tips. Untangling and optimization repeat while hexes stay inverted.
 //      Optimization stops when the largest node movement of a sweep, relative to the node's mean incident
-//      edge length, falls below the tolerance, or when a sweep lowers E by less than 1e-5 of it.
+//      edge length, falls below the tolerance, or when a sweep lowers E by less than 1e-5 of it. With
+//      OptimizeOptions::reactivate, a node that hardly moved is skipped until a node of its hexes moves;
+//   4. optionally (OptimizeOptions::worst_element_threshold), a worst-element pass in two stages. First the
+//      nodes of the hexes whose scaled Jacobian or 3 / kappa (both 1 for a cube) is below the threshold,
+//      worst hex first, ascend a soft minimum of both measures of the corners that depend on them (the
+//      untangler's method on other measures), a step accepted only when the true minimum of those grows,
+//      so the mesh's smallest min(scaled Jacobian, 3 / kappa) never falls. Then a few sweeps over every
+//      node raise the scaled Jacobian alone, no corner's condition number growing beyond the mesh's
+//      largest. Boundary nodes slide, never to a point farther from where the optimization found them
+//      than worst_element_reach of an edge or than they already are.
 // Cost: one sweep is O(m) for m hexes (each corner is evaluated a few times per node that it depends on);
-// the jaw at 2,500 hexes converges in about 70 sweeps; each boundary trial costs one closest-point query,
-// O(log t) for t surface triangles.
+// the jaw at 2,500 hexes converges in about 70 sweeps (about 55 with reactivate = 0.01); each boundary
+// trial costs one closest-point query, O(log t) for t surface triangles, started from the node's current
+// closest point. The worst-element pass costs O(m) per sweep at most.
 // Deterministic: single-threaded, fixed node and hex orders, no hashing.
 #pragma once
 
@@ -46,6 +56,21 @@ struct OptimizeOptions {
   // local edge length, so that they cannot abandon thin tips and ridges of the surface (0 = no tether).
   double boundary_tether = 0.5;
   int max_repeats = 5;  // untangle + optimize cycles while hexes stay inverted
+  // Nodes that moved less than this (relative to their edge length) in a sweep are skipped until a node of
+  // one of their hexes moves more (0 = every movable node in every sweep).
+  double reactivate = 0.0;
+  // Worst-element pass after a valid optimization: the nodes of hexes whose scaled Jacobian or 3 / kappa
+  // is below this threshold locally maximize a soft minimum of both measures of the corners around them
+  // (0 = no pass).
+  double worst_element_threshold = 0.0;
+  int worst_element_sweeps = 20;  // sweeps of that stage
+  // The pass never moves a sliding node to a point farther than this fraction of its edge length (or than
+  // it already is) from where the optimization found it (optimize_hex_mesh) or the pass did
+  // (improve_worst_elements without `home`).
+  double worst_element_reach = 0.25;
+  // Then sweeps over every node raising the soft minimum of the scaled Jacobian alone, no corner's
+  // condition number growing beyond the mesh's largest (needs worst_element_threshold > 0).
+  int scaled_jacobian_sweeps = 0;
 };
 
 // One row of the per-phase table.
@@ -60,6 +85,7 @@ struct OptimizeReport {
   int untangle_sweeps = 0;           // over all untangling phases
   int iterations = 0;                // optimization sweeps (per-node Newton steps over all movable nodes)
   int rounds = 0;                    // untangle + optimize cycles
+  int worst_element_sweeps = 0;      // sweeps of the worst-element pass (both stages)
   double energy_before = 0.0;        // sum of squared corner condition numbers, valid hexes only
   double energy_after = 0.0;
   int inverted = 0;  // inverted hexes at the end
@@ -87,5 +113,14 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
 int optimize_condition(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
                        const SurfaceProjector* surface, const OptimizeOptions& options,
                        int* rounds = nullptr);
+// The worst-element pass (phase 4) on a valid mesh, both stages; returns the number of sweeps. Does
+// nothing when a hex is inverted or options.worst_element_threshold is not positive.
+// Sliding nodes never step farther from `home` (default: where the pass finds them) than
+// options.worst_element_reach of an edge or than they already are; optimize_hex_mesh passes the positions on
+// entry to the optimization, so that the pass and the tethered optimization together cannot walk a node away
+// from a thin tip.
+int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
+                           const SurfaceProjector* surface, const OptimizeOptions& options,
+                           const std::vector<Vec3>* home = nullptr);
 
 }  // namespace hexbite

@@ -32,6 +32,7 @@ Vec3 to_vec(const Point& p) {
 struct SurfaceProjector::Impl {
   Mesh mesh;
   std::vector<int> face_to_triangle;  // Surface_mesh face index -> TriSurface triangle index
+  std::vector<int> triangle_to_face;  // the inverse
   std::vector<Vec3> normals;          // per TriSurface triangle
   std::unique_ptr<Tree> tree;
   std::unique_ptr<Inside> inside;
@@ -67,6 +68,7 @@ SurfaceProjector::SurfaceProjector(const TriSurface& surface) : surface_(surface
     }
     if (impl_->face_to_triangle.size() <= f.idx()) impl_->face_to_triangle.resize(f.idx() + 1, -1);
     impl_->face_to_triangle[f.idx()] = static_cast<int>(t);
+    impl_->triangle_to_face.push_back(static_cast<int>(f.idx()));
     const Vec3& a = surface.vertices[tri[0]];
     const Vec3& b = surface.vertices[tri[1]];
     const Vec3& c = surface.vertices[tri[2]];
@@ -86,6 +88,15 @@ SurfaceProjector::~SurfaceProjector() = default;
 
 SurfacePoint SurfaceProjector::closest(const Vec3& query) const {
   const auto pp = impl_->tree->closest_point_and_primitive(Point(query[0], query[1], query[2]));
+  return impl_->make_point(pp.first, pp.second, query);
+}
+
+SurfacePoint SurfaceProjector::closest(const Vec3& query, const SurfacePoint& hint) const {
+  if (hint.triangle < 0 || hint.triangle >= static_cast<int>(impl_->triangle_to_face.size()))
+    return closest(query);
+  const Tree::Point_and_primitive_id start(Point(hint.point[0], hint.point[1], hint.point[2]),
+                                           Mesh::Face_index(impl_->triangle_to_face[hint.triangle]));
+  const auto pp = impl_->tree->closest_point_and_primitive(Point(query[0], query[1], query[2]), start);
   return impl_->make_point(pp.first, pp.second, query);
 }
 

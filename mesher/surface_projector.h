@@ -32,6 +32,10 @@ class SurfaceProjector {
   SurfaceProjector& operator=(const SurfaceProjector&) = delete;
 
   SurfacePoint closest(const Vec3& query) const;
+  // The same closest point, found faster when `hint` (a point on the surface with its triangle, such as an
+  // earlier answer for a nearby query) is close to it: the search starts from the hint instead of the
+  // tree's own first guess. Equidistant candidates may resolve to a different triangle than closest(query).
+  SurfacePoint closest(const Vec3& query, const SurfacePoint& hint) const;
   double distance(const Vec3& query) const;
   // True when the query lies strictly inside the solid (points on the surface count as outside).
   bool inside(const Vec3& query) const;
