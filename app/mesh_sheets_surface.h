@@ -1,7 +1,8 @@
 // The sheet mesher on a triangulated mandible: `hexbite quad from-mandible SURFACE -o Q.obj` (the quad
 // surface only) and `hexbite mesh SURFACE --method sheets -o mesh.vtu` (quad surface, then cycle
-// elimination, embedding and optimization). The quad surface comes from mesher/quad_surface_placement.h;
-// cmd_quad.cc and cmd_mesh.cc only forward their options here.
+// elimination, a pillow layer, embedding and optimization with the boundary sliding on the input). The quad
+// surface comes from mesher/quad_surface_placement.h; cmd_quad.cc and cmd_mesh.cc only forward their options
+// here.
 #pragma once
 
 #include <string>
@@ -29,8 +30,14 @@ struct MeshSheetsSurfaceOptions {
   bool allow_invalid = false;
 };
 
-// mesh SURFACE --method sheets: quad surface, cycle elimination and embedding, then the report (the keys of
-// the sheet mesher's report plus the quad surface's) and the mesh written atomically.
+// mesh SURFACE --method sheets: quad surface, cycle elimination (the sheet mesher smooths the interior
+// only), then a pillow layer under the quad surface (every boundary quad gets one hex, so no hex keeps two
+// faces on a thin rim or tip) and optimize_hex_mesh with the input's SurfaceProjector: the quad surface
+// being our own construction, its nodes slide on the input, only the landmark nodes stay fixed. Then the
+// report (the keys of the sheet mesher's report, `pillow_hexes`, the quad surface's, and `fidelity` of the
+// slid boundary against the input) and the mesh written atomically; RunError listing the inverted hexes
+// when some remain, unless allow_invalid. (`mesh --quad-surface Q.obj --method sheets`, app/mesh_sheets.cc,
+// keeps its input boundary exactly.)
 void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& options);
 
 }  // namespace hexbite

@@ -547,6 +547,101 @@ void relax(QuadSurface& fine, const PlacementSurface& s, const std::vector<char>
   }
 }
 
+// Agreement of a quad corner with the input: the cosine between the corner normal (cross product of its
+// two edges) and the input normal where the corner node sits; <= 0 is a folded corner.
+double corner_agreement(const QuadSurface& q, const std::array<int, 4>& quad, int k,
+                        const std::vector<Vec3>& surface_normal) {
+  const Vec3& p = q.vertices[quad[k]];
+  const Vec3 c = cross(sub(q.vertices[quad[(k + 1) % 4]], p), sub(q.vertices[quad[(k + 3) % 4]], p));
+  return dot(unit(c), surface_normal[quad[k]]);
+}
+
+// Untangling of the quad surface on the input: the nodes of folded quads (a corner agreement <= 0, the input
+// normal at a node being that of the triangle closest() names, as in the report) try positions around them
+// on the surface (8 tangent directions at 3 step lengths, the centroid of their quads, each placed by the
+// restricted projection or the plain one) and take the one that raises the smallest agreement over every
+// corner of their quads the most, unless it moves a centre of their quads farther from the input than both
+// 0.2 of their mean edge and the farthest one before (no quad may come to bridge a gap); sweeps repeat
+// while some node improves. The smallest agreement of the surface therefore never falls.
+void unfold(QuadSurface& fine, const PlacementSurface& s, const std::vector<char>& fixed, int sweeps,
+            std::vector<Vec3>* surface_normal) {
+  constexpr double kUnfoldGap = 0.2;  // of the node's mean edge length
+  std::vector<std::vector<int>> vertex_quads(fine.vertices.size());
+  for (std::size_t q = 0; q < fine.quads.size(); ++q)
+    for (int v : fine.quads[q]) vertex_quads[v].push_back(static_cast<int>(q));
+  // The input normal at a node: that of the triangle closest() names, as in the folded-quad count (at a
+  // crease of the input the triangle the node was projected onto may be another one).
+  for (std::size_t v = 0; v < fine.vertices.size(); ++v)
+    (*surface_normal)[v] = s.projector.closest(fine.vertices[v]).normal;
+  auto local_min = [&](std::size_t v) {
+    double m = 1.0;
+    for (int q : vertex_quads[v])
+      for (int k = 0; k < 4; ++k) m = std::min(m, corner_agreement(fine, fine.quads[q], k, *surface_normal));
+    return m;
+  };
+  // The largest distance of the centres and edge midpoints of v's quads from the input: a move may not make
+  // a quad bridge a gap.
+  auto gap = [&](std::size_t v) {
+    double g = 0;
+    for (int q : vertex_quads[v])
+      for (const auto& [a, b] : {std::pair{0.5, 0.5}, {0.5, 0.0}, {1.0, 0.5}, {0.5, 1.0}, {0.0, 0.5}})
+        g = std::max(g, s.projector.distance(bilinear(fine, fine.quads[q], a, b)));
+    return g;
+  };
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    const std::vector<Vec3> normals = vertex_normals(fine);
+    std::vector<char> active(fine.vertices.size(), 0);
+    for (const auto& quad : fine.quads) {
+      bool bad = false;
+      for (int k = 0; k < 4; ++k) bad = bad || corner_agreement(fine, quad, k, *surface_normal) <= 0;
+      if (bad)
+        for (int v : quad) active[v] = 1;
+    }
+    bool improved = false;
+    for (std::size_t v = 0; v < fine.vertices.size(); ++v) {
+      if (!active[v] || fixed[v]) continue;
+      const Vec3 start = fine.vertices[v], start_normal = (*surface_normal)[v];
+      double edge = 0, best = local_min(v);
+      Vec3 centroid{0, 0, 0};
+      for (int q : vertex_quads[v])
+        for (int w : fine.quads[q]) {
+          centroid = add(centroid, scale(fine.vertices[w], 0.25 / vertex_quads[v].size()));
+          edge += norm(sub(fine.vertices[w], start)) / (3.0 * vertex_quads[v].size());
+        }
+      const double allowed_gap = std::max(gap(v), kUnfoldGap * edge);
+      Vec3 best_point = start, best_normal = start_normal;
+      const Vec3 n = normals[v];
+      const Vec3 t1 = unit(cross(n, std::abs(n[0]) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+      const Vec3 t2 = cross(n, t1);
+      std::vector<Vec3> candidates{centroid};
+      for (double step : {0.5, 0.25, 0.1})
+        for (int a = 0; a < 8; ++a) {
+          const double angle = a * std::acos(-1.0) / 4;
+          candidates.push_back(
+              add(start, scale(add(scale(t1, std::cos(angle)), scale(t2, std::sin(angle))), step * edge)));
+        }
+      for (const Vec3& c : candidates)
+        for (int restricted = 0; restricted < 2; ++restricted) {
+          const SurfacePoint sp =
+              restricted ? s.oriented.closest(c, n, Vec3{0, 0, 0}) : s.projector.closest(c);
+          if (sp.triangle < 0) continue;
+          fine.vertices[v] = sp.point;
+          (*surface_normal)[v] = s.projector.closest(sp.point).normal;
+          const double m = local_min(v);
+          if (m > best + 1e-9 && gap(v) <= allowed_gap) {
+            best = m;
+            best_point = sp.point;
+            best_normal = (*surface_normal)[v];
+          }
+        }
+      fine.vertices[v] = best_point;
+      (*surface_normal)[v] = best_normal;
+      improved = improved || norm(sub(best_point, start)) > 0;
+    }
+    if (!improved) break;
+  }
+}
+
 std::string point_text(const Vec3& p) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
@@ -643,10 +738,12 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
       surface_normal[best] = on_surface.normal;
       fixed[best] = 1;
       report.landmark_nodes.push_back({name, norm(sub(on_surface.point, p))});
+      report.landmark_vertices.push_back(best);
     }
 
   // 6. Relaxation on the target.
   relax(fine, target, fixed, options.relax_sweeps, &surface_normal);
+  unfold(fine, target, fixed, options.unfold_sweeps, &surface_normal);
   progress.update(0.9, "relaxed");
 
   // 7. Fidelity.

@@ -43,18 +43,23 @@
 //      projection; nodes move one at a time and a move that folds more quad corners around the node than
 //      before (a corner normal against the input normal there) is undone, and a node that still has folded
 //      corners around it tries the plain centroid of its quads (on whichever face suits it) instead.
-//   7. Fidelity. Vertex distance to the input, quad-to-surface distance sampled on each bilinear quad, and
+//   7. Untangling. The nodes of the quads still folded (a corner normal against the input normal) take,
+//      among positions around them on the surface, the one that raises the smallest corner agreement
+//      (cosine of corner normal and input normal) over their quads the most, as long as no centre or edge
+//      midpoint of their quads ends farther from the input than 0.2 of an edge and than before (no quad
+//      comes to bridge a gap); this never lowers the surface's smallest agreement.
+//   8. Fidelity. Vertex distance to the input, quad-to-surface distance sampled on each bilinear quad, and
 //      surface-to-quads distance of every input vertex (CGAL AABB trees, mesher/surface_projector.h); folded
 //      quads (a corner normal against the surface normal).
 // Limitations (measured, docs/mandible_quads.md): at 1,300 quads the Hausdorff distance is 1.6 mm on the
-// built-in mandible and 3.2 mm on the real jaw (1 mm is the goal), and up to 20 quads fold over the real
-// jaw's thin rims and incisors.
+// built-in mandible and 3.2 mm on the real jaw (1 mm is the goal; the molar cusps and the condyle poles are
+// finer than the 3.6 mm quads), and at 3,000 quads a few quads still fold (up to 8 on the real jaw).
 // Failure: InputError when a landmark file lacks the points the template needs (naming the file and the
 // missing names), when the surface is not mandible-like (its Hausdorff distance to the placed template
 // exceeds 10 mm, naming where), or when the target is out of range.
 // Cost: O(T log T) for T input triangles plus O((Q + V) sweeps) for Q quads and V input vertices (the Lloyd
-// assignment); about 0.7 s for 50,000 triangles and 1,300 quads. Deterministic (single-threaded, fixed
-// orders).
+// assignment), plus about a thousand closest-point queries per node of a folded quad and untangling sweep;
+// about 0.7 s for 50,000 triangles and 1,300 quads. Deterministic (single-threaded, fixed orders).
 #pragma once
 
 #include <string>
@@ -69,6 +74,7 @@ namespace hexbite {
 struct MandibleQuadOptions {
   int target_quads = 1300;  // 24 to 200,000
   int relax_sweeps = 40;
+  int unfold_sweeps = 30;  // step 7
   // Thin-plate spline regularization per kind of point: landmarks are trusted, muscle insertions (whose
   // definitions differ between sources) and extreme points only guide.
   double landmark_smoothing_mm = 0.5;
@@ -88,12 +94,13 @@ struct MandibleQuadReport {
   // Landmark nodes: name and distance from the landmark to the quad node placed for it (the landmark's
   // closest surface point).
   std::vector<std::pair<std::string, double>> landmark_nodes;
-  double max_vertex_distance_mm = 0;  // quad vertices to the input surface
-  double quads_to_surface_mm = 0;     // sampled bilinear quads to the input surface
-  double surface_to_quads_mm = 0;     // input vertices to the quad surface
-  double hausdorff_mm = 0;            // max of the two above
-  Vec3 worst_quad_point{};            // where the quads are farthest from the surface
-  Vec3 worst_surface_point{};         // the input vertex farthest from the quads
+  std::vector<int> landmark_vertices;  // the quad vertex of each landmark node, in the same order
+  double max_vertex_distance_mm = 0;   // quad vertices to the input surface
+  double quads_to_surface_mm = 0;      // sampled bilinear quads to the input surface
+  double surface_to_quads_mm = 0;      // input vertices to the quad surface
+  double hausdorff_mm = 0;             // max of the two above
+  Vec3 worst_quad_point{};             // where the quads are farthest from the surface
+  Vec3 worst_surface_point{};          // the input vertex farthest from the quads
   double mean_edge_mm = 0;
   // Quads with a corner whose normal (cross product of its two edges) points against the input surface's
   // normal there: folded or twisted quads, which no valid hex mesh can have as boundary faces.
