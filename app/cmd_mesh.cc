@@ -1,5 +1,5 @@
-// hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--json]
-// [--allow-invalid]
+// hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--landmarks L.yaml]
+// [--json] [--allow-invalid]
 // hexbite mesh SURFACE --method sheets [--landmarks L.yaml] --target-hexes N -o mesh.vtu (a mandible:
 // app/mesh_sheets_surface.h) or hexbite mesh --method sheets --quad-surface Q.obj -o mesh.vtu
 // (app/mesh_sheets.h)
@@ -7,7 +7,8 @@
 // Meshes a closed triangulated solid with hexahedra (overlay grid + pillow layer + optimization) and prints
 // the quality per phase (like the seed paper's Table 1), the timings and the geometric fidelity. A mesh
 // that stays inverted is a failed run (exit 1, naming the inverted hexes with their centroids) and is not
-// written unless --allow-invalid asks for it.
+// written unless --allow-invalid asks for it. With --landmarks, the surface regions that the cell size
+// cannot resolve are named by their nearest landmark and muscle insertion.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
@@ -22,6 +23,7 @@
 #include "common/progress.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/landmarks.h"
 #include "mesher/surface_check.h"
 #include "mesher/units.h"
 #include "postprocess/quality_json.h"
@@ -44,7 +46,7 @@ struct MeshOptions {
   double margin = GridMeshOptions{}.margin;
   std::string quad_surface;         // --method sheets
   std::string order = "geometric";  // --method sheets
-  std::string landmarks;            // --method sheets on a SURFACE
+  std::string landmarks;            // --method sheets on a SURFACE; names unresolved parts for grid
 };
 
 std::string fmt(const char* format, double v) {
@@ -81,9 +83,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core"
-      << (r.attempts > 1
-              ? ", grid " + std::to_string(r.attempts) + " of 3 (earlier grids left inverted hexes)"
-              : std::string())
+      << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grid positions" : std::string())
       << "\n\n";
   out << phase_table(r.optimize) << '\n';
   out << "optimizer: " << r.optimize.untangle_sweeps << " untangling sweeps, " << r.optimize.iterations
@@ -122,6 +122,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["cells_added_for_manifold"] = r.cells_added_for_manifold;
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
   j["grid_attempts"] = r.attempts;
+  j["landmarks"] = o.landmarks.empty() ? nlohmann::json() : nlohmann::json(o.landmarks);
   nlohmann::json phases = nlohmann::json::array();
   for (const PhaseQuality& p : r.optimize.phases)
     phases.push_back({{"phase", p.phase}, {"seconds", p.seconds}, {"quality", quality_to_json(p.quality)}});
@@ -138,9 +139,15 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
                   {"total", r.seconds_total}};
   const MeshFidelity& f = r.fidelity;
   nlohmann::json unresolved = nlohmann::json::array();
-  for (const UnresolvedPart& u : f.unresolved)
-    unresolved.push_back(
-        {{"location", u.location}, {"extent_mm", u.extent}, {"samples", u.samples}, {"what", u.what}});
+  for (const UnresolvedPart& u : f.unresolved) {
+    nlohmann::json near = nlohmann::json::array();
+    for (const NearbyPoint& n : u.near) near.push_back({{"name", n.name}, {"distance_mm", n.distance}});
+    unresolved.push_back({{"location", u.location},
+                          {"extent_mm", u.extent},
+                          {"samples", u.samples},
+                          {"near", near},
+                          {"what", u.what}});
+  }
   j["fidelity"] = {{"hausdorff_mm", f.hausdorff},
                    {"hausdorff_mesh_to_surface_mm", f.hausdorff_mesh_to_surface},
                    {"hausdorff_surface_to_mesh_mm", f.hausdorff_surface_to_mesh},
@@ -183,12 +190,15 @@ void run_mesh(const MeshOptions& o) {
                      std::to_string(kMinTarget) + " to " + std::to_string(kMaxTarget));
   const double scale = unit_to_mm(o.units);
   const TriSurface surface = load_closed_surface(o.surface, scale);
+  std::unique_ptr<Landmarks> landmarks;
+  if (!o.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(o.landmarks, scale));
 
   GridMeshOptions options;
   options.target_hexes = o.target;
   options.margin = o.margin;
   GridMeshReport report;
   const HexMesh mesh = grid_mesh(surface, options, &report);
+  if (landmarks) name_unresolved_parts(*landmarks, report.fidelity.unresolved);
   const QualitySummary& final_quality = report.optimize.phases.back().quality;
   const bool valid = final_quality.inverted == 0;
   const bool write = valid || o.allow_invalid;
@@ -223,7 +233,8 @@ void add_mesh_command(CLI::App& app) {
                   "Quad surface of a ball (.obj .vtp .vtk), for --method sheets");
   cmd->add_option(
       "--landmarks", o->landmarks,
-      "Landmark file (.yaml) of the SURFACE, placing the mandible quad template for --method sheets");
+      "Landmark file (.yaml) of the SURFACE: places the mandible quad template for --method sheets, and "
+      "names the parts too thin for the cell size by their nearest landmark for --method grid");
   cmd->add_option("--order", o->order,
                   "Elimination order for --method sheets: geometric, fewest-hexes or look-ahead")
       ->capture_default_str();

@@ -470,9 +470,11 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
   }
   for (std::size_t r = 0; r < parts.size(); ++r) {
     parts[r].location = scale(sums[r], 1.0 / parts[r].samples);
-    parts[r].what = "the surface near " + format_point(parts[r].location) + " lies up to " +
-                    std::to_string(parts[r].extent) + " mm from the mesh (" +
-                    std::to_string(parts[r].samples) +
+    std::ostringstream extent;
+    extent.precision(1);
+    extent << std::fixed << parts[r].extent;
+    parts[r].what = "the surface near " + format_point(parts[r].location) + " lies up to " + extent.str() +
+                    " mm from the mesh (" + std::to_string(parts[r].samples) +
                     " triangles): a part too thin for this cell size; ask for more hexes to resolve it";
   }
   std::stable_sort(parts.begin(), parts.end(),
@@ -481,6 +483,35 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
 }
 
 }  // namespace
+
+void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPart>& parts) {
+  for (UnresolvedPart& part : parts) {
+    // The nearest of each kind; ties go to the first in the file's order (points are ordered by name).
+    NearbyPoint point{"", kInf}, insertion{"", kInf};
+    for (const auto& [name, p] : landmarks.points) {
+      const double d = norm(sub(p, part.location));
+      if (d < point.distance) point = {name, d};
+    }
+    for (const MuscleLine& m : landmarks.muscles) {
+      const double d = norm(sub(m.insertion, part.location));
+      if (d < insertion.distance) insertion = {m.name + ".insertion", d};
+    }
+    part.near.clear();
+    for (const NearbyPoint& n : {point, insertion})
+      if (!n.name.empty()) part.near.push_back(n);
+    if (part.near.size() == 2 && part.near[1].distance < part.near[0].distance)
+      std::swap(part.near[0], part.near[1]);
+    if (part.near.empty()) continue;
+    std::string names;
+    for (const NearbyPoint& n : part.near) {
+      std::ostringstream d;
+      d.precision(1);
+      d << std::fixed << n.distance;
+      names += (names.empty() ? "near " : ", ") + n.name + " (" + d.str() + " mm)";
+    }
+    part.what = names + ": " + part.what;
+  }
+}
 
 double hex_mesh_volume(const HexMesh& mesh) {
   // Reference coordinates of the VTK hexahedron's nodes.

@@ -4,7 +4,8 @@
 // and a target number of hexes.
 // Output: a positively oriented HexMesh whose boundary nodes lie on the surface, and a report with the
 // chosen cell size, the per-phase quality table, the geometric fidelity (two-sided sampled Hausdorff
-// distance and volume difference) and the surface regions the cell size could not resolve.
+// distance and volume difference) and the surface regions the cell size could not resolve, which
+// name_unresolved_parts names by the nearest landmark and muscle insertion of a landmark file.
 // Algorithm:
 //   1. cell size h from the target, counting the pillow layer (core cells + core boundary quads), found by
 //      a few secant steps on the actual counts;
@@ -19,7 +20,7 @@
 //      a copy on the surface (along the vertex normal, or the closest point), and each core boundary quad one
 //      hex to it, so no hex has two boundary faces;
 //   4. optimize_hex_mesh with the boundary sliding on the surface, resting nodes skipped, and its
-//      worst-element pass (hexes with a scaled Jacobian or 3 / kappa below 0.5);
+//      worst-element pass (hexes with a scaled Jacobian or 3 / kappa below 0.5; both stages twice);
 //   5. steps 1-4 again on the grid shifted by half a cell, then by a quarter; the mesh with the fewest
 //      inverted hexes, then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept.
 // Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
@@ -33,6 +34,7 @@
 
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_optimize.h"
+#include "mesher/landmarks.h"
 #include "mesher/tri_surface.h"
 
 namespace hexbite {
@@ -48,15 +50,22 @@ struct GridMeshOptions {
   // Grids tried, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3). The mesh with
   // the fewest inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
   int grids = 3;
-  // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass.
+  // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass, twice.
   OptimizeOptions optimize = [] {
     OptimizeOptions o;
     o.reactivate = 0.01;
     o.worst_element_threshold = 0.5;
     o.worst_element_reach = 0.8;
     o.scaled_jacobian_sweeps = 3;
+    o.worst_element_rounds = 2;
     return o;
   }();
+};
+
+// A named point near an unresolved part: a landmark, or a muscle insertion ("<muscle>.insertion").
+struct NearbyPoint {
+  std::string name;
+  double distance = 0;  // from the part's location, mm
 };
 
 // A region of the surface that the mesh does not reach (a part too thin for the cell size, or a core
@@ -66,6 +75,9 @@ struct UnresolvedPart {
   double extent = 0;  // largest distance of the region's surface from the mesh boundary, mm
   int samples = 0;    // surface samples (vertices and triangle centroids) in the region
   std::string what;   // one sentence
+  // Set by name_unresolved_parts: the nearest landmark and the nearest muscle insertion, nearest first
+  // (empty without landmarks).
+  std::vector<NearbyPoint> near;
 };
 
 struct MeshFidelity {
@@ -97,6 +109,10 @@ struct GridMeshReport {
 // cell at any size; the returned mesh may contain inverted hexes (report.optimize.inverted says how many).
 HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options,
                   GridMeshReport* report = nullptr);
+
+// Names each part by the nearest landmark point and the nearest muscle insertion of `landmarks` (each when
+// there is one): fills `near` and starts `what` with "near left_coronoid_tip (3.2 mm), ...: ".
+void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPart>& parts);
 
 // Volume of a hex mesh with trilinear hexes (2 x 2 x 2 Gauss points, exact for trilinear maps).
 double hex_mesh_volume(const HexMesh& mesh);

@@ -724,7 +724,10 @@ int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, cons
   int sweeps = 0;
   // The first stage raises both measures of the hexes below the threshold; the second the scaled Jacobian
   // of every hex, with no corner's 3 / kappa falling below the mesh's smallest.
-  for (int stage = 0; stage < 2; ++stage) {
+  // The stages repeat worst_element_rounds times: the second stage moves nodes that then give the first
+  // one room again.
+  for (int run = 0; run < 2 * std::max(options.worst_element_rounds, 1); ++run) {
+    const int stage = run % 2;
     const bool with_kappa = stage == 0;
     const double threshold = with_kappa ? options.worst_element_threshold : 1.0;
     const int max_sweeps = with_kappa ? options.worst_element_sweeps : options.scaled_jacobian_sweeps;

@@ -28,7 +28,8 @@
 //      so the mesh's smallest min(scaled Jacobian, 3 / kappa) never falls. Then a few sweeps over every
 //      node raise the scaled Jacobian alone, no corner's condition number growing beyond the mesh's
 //      largest. Boundary nodes slide, never to a point farther from where the optimization found them
-//      than worst_element_reach of an edge or than they already are.
+//      than worst_element_reach of an edge or than they already are. Both stages repeat
+//      worst_element_rounds times.
 // Cost: one sweep is O(m) for m hexes (each corner is evaluated a few times per node that it depends on);
 // the jaw at 2,500 hexes converges in about 70 sweeps (about 55 with reactivate = 0.01); each boundary
 // trial costs one closest-point query, O(log t) for t surface triangles, started from the node's current
@@ -71,6 +72,8 @@ struct OptimizeOptions {
   // Then sweeps over every node raising the soft minimum of the scaled Jacobian alone, no corner's
   // condition number growing beyond the mesh's largest (needs worst_element_threshold > 0).
   int scaled_jacobian_sweeps = 0;
+  // Both stages of the pass run this many times in turn (the second stage's moves give the first room).
+  int worst_element_rounds = 1;
 };
 
 // One row of the per-phase table.
@@ -113,7 +116,8 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
 int optimize_condition(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
                        const SurfaceProjector* surface, const OptimizeOptions& options,
                        int* rounds = nullptr);
-// The worst-element pass (phase 4) on a valid mesh, both stages; returns the number of sweeps. Does
+// The worst-element pass (phase 4) on a valid mesh, both stages, worst_element_rounds times; returns the
+// number of sweeps. Does
 // nothing when a hex is inverted or options.worst_element_threshold is not positive.
 // Sliding nodes never step farther from `home` (default: where the pass finds them) than
 // options.worst_element_reach of an edge or than they already are; optimize_hex_mesh passes the positions on

@@ -194,9 +194,11 @@ double distance_outside(const HexMesh& mesh, const Vec3& p) {
 // docs/meshing.md). Reached and asserted: a valid mesh, no hex with two boundary faces, and no part lost:
 // the coronoid processes (temporalis insertions, on the surface) and the condyles (TMJ points, inside the
 // bone) are inside the mesh or close to it, and where a tip falls short it is reported by location. Met: the
-// 5 s budget (3.0 s of CPU for three grids, Release). Not met, asserted at the measured level instead
-// (measured: SJ min 0.2996, mean 0.70, kappa max 10.8, volume -4.1 %, Hausdorff 1.45 mean edge lengths):
-// SJ min >= 0.3, mean >= 0.85, kappa max <= 10, volume within 3 %, Hausdorff <= 0.5 mean edge.
+// 5 s budget (3.9 s of CPU for three grids, Release) and SJ min >= 0.3 (0.305, but not robustly: 0.25 at
+// 2,000 and 0.28 at 3,000 hexes; asserted with a margin). Not met, asserted at the measured level instead
+// (measured: mean 0.704, kappa max 10.79, volume -4.17 %, Hausdorff 1.43 mean edge lengths): mean >= 0.85,
+// kappa max <= 10 (the ramus and coronoid plates are 1.7-2 mm thick against 4.6 mm cells, see
+// docs/meshing.md), volume within 3 %, Hausdorff <= 0.5 mean edge.
 TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
   SurfaceReport sr;
   const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0, &sr);
@@ -204,11 +206,11 @@ TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
   expect_common(o);
   const MeshFidelity& f = o.report.fidelity;
   EXPECT_NEAR(double(o.mesh.hexes.size()), 2500.0, 250.0);
-  EXPECT_GE(o.quality.scaled_jacobian.min, 0.28);     // reached 0.2996; the target is 0.3
-  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.69);    // reached 0.699; the target is 0.85
-  EXPECT_LE(o.quality.condition.max, 11.5);           // reached 10.8; the target is 10
-  EXPECT_LT(std::fabs(f.volume_difference), 0.045);   // reached 4.1 %; target 3 %
-  EXPECT_LE(f.hausdorff, 1.55 * f.mean_edge_length);  // reached 1.45; target 0.5
+  EXPECT_GE(o.quality.scaled_jacobian.min, 0.29);     // reached 0.305; the target 0.3, met here only
+  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.695);   // reached 0.704; the target is 0.85
+  EXPECT_LE(o.quality.condition.max, 11.2);           // reached 10.79; the target is 10
+  EXPECT_LT(std::fabs(f.volume_difference), 0.045);   // reached 4.17 %; target 3 %
+  EXPECT_LE(f.hausdorff, 1.55 * f.mean_edge_length);  // reached 1.43; target 0.5
   // The temporalis inserts on the coronoid processes; the supports sit at the condyles.
   const Landmarks lm = read_landmarks(test::shared_data("jaw/landmarks.yaml"));
   for (const char* name : {"left_middle_temporalis.insertion", "right_middle_temporalis.insertion",
@@ -218,6 +220,7 @@ TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
     // Reached: the coronoid tips fall short by 1.04 and 1.20 mean edge lengths (target 0.5, as the Hausdorff
     // distance); such a shortfall must be reported as an unresolved part near the point.
     const double d = distance_outside(o.mesh, *p);
+    std::cout << name << " outside the mesh by " << d / f.mean_edge_length << " mean edges\n";
     EXPECT_LE(d, 1.3 * f.mean_edge_length) << name;
     if (d <= 0.5 * f.mean_edge_length) continue;
     bool reported = false;
@@ -230,22 +233,75 @@ TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
 }
 
 // The built-in mandible (generate_mandible with its defaults) at 2,500 hexes. Met: 0 inverted, SJ min >= 0.3
-// (0.53), kappa max <= 10 (6.7), no part lost. NOT met, asserted at the measured level (measured: SJ mean
-// 0.75, volume -3.30 %, Hausdorff 0.59 mean edge lengths): mean >= 0.85, volume within 3 %, Hausdorff <= 0.5.
+// (0.547), kappa max <= 10 (6.53), no part lost. NOT met, asserted at the measured level (measured: SJ mean
+// 0.755, volume -3.33 %, Hausdorff 0.61 mean edge lengths): mean >= 0.85, volume within 3 %, Hausdorff <=
+// 0.5.
 TEST(GridMesher, BuiltInMandibleAt2500) {
   const GeneratedMandible g = generate_mandible({});
   const Outcome o = run(g.surface, 2500);
   expect_common(o);
   const MeshFidelity& f = o.report.fidelity;
   EXPECT_NEAR(double(o.mesh.hexes.size()), 2500.0, 250.0);
-  EXPECT_GE(o.quality.scaled_jacobian.min, 0.5);     // reached 0.53; the target 0.3 is met
-  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.73);   // reached 0.75; the target is 0.85
-  EXPECT_LE(o.quality.condition.max, 7.5);           // reached 6.7; the target 10 is met
-  EXPECT_LT(std::fabs(f.volume_difference), 0.036);  // reached 3.30 %; target 3 %
-  EXPECT_LE(f.hausdorff, 0.7 * f.mean_edge_length);  // reached 0.59; target 0.5
+  EXPECT_GE(o.quality.scaled_jacobian.min, 0.5);     // reached 0.547; the target 0.3 is met
+  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.74);   // reached 0.755; the target is 0.85
+  EXPECT_LE(o.quality.condition.max, 7.5);           // reached 6.53; the target 10 is met
+  EXPECT_LT(std::fabs(f.volume_difference), 0.036);  // reached 3.33 %; target 3 %
+  EXPECT_LE(f.hausdorff, 0.7 * f.mean_edge_length);  // reached 0.61; target 0.5
   for (const char* name :
        {"left_coronoid_tip", "right_coronoid_tip", "left_condyle_tmj_point", "right_condyle_tmj_point"})
     EXPECT_LE(distance_outside(o.mesh, g.landmarks.points.at(name)), f.mean_edge_length) << name;
+}
+
+// Unresolved parts are named by the nearest landmark and the nearest muscle insertion, nearest first; without
+// landmarks they keep their coordinates only.
+TEST(GridMesher, NamesUnresolvedPartsByTheNearestLandmark) {
+  Landmarks lm;
+  lm.points["left_coronoid_tip"] = {10, 0, 0};
+  lm.points["incisal_point"] = {0, -40, 0};
+  lm.muscles.push_back({"left_middle_temporalis", 95.6, {10, 0, 4}, {10, 20, 60}});
+  UnresolvedPart part;
+  part.location = {10, 0, 3};
+  part.what = "the surface near (10.0, 0.0, 3.0) mm lies up to 2 mm from the mesh";
+  std::vector<UnresolvedPart> parts{part};
+  name_unresolved_parts(Landmarks{}, parts);
+  EXPECT_TRUE(parts[0].near.empty());
+  EXPECT_EQ(parts[0].what, part.what);
+  name_unresolved_parts(lm, parts);
+  ASSERT_EQ(parts[0].near.size(), 2u);
+  EXPECT_EQ(parts[0].near[0].name, "left_middle_temporalis.insertion");
+  EXPECT_NEAR(parts[0].near[0].distance, 1.0, 1e-12);
+  EXPECT_EQ(parts[0].near[1].name, "left_coronoid_tip");
+  EXPECT_NEAR(parts[0].near[1].distance, 3.0, 1e-12);
+  EXPECT_EQ(parts[0].what,
+            "near left_middle_temporalis.insertion (1.0 mm), left_coronoid_tip (3.0 mm): " + part.what);
+}
+
+// "Thin parts that the requested size cannot resolve are reported by name and location": the built-in
+// mandible at 1,000 hexes (cells of 7.0 mm) loses the tips of its coronoid processes (regions up to 4.6 mm
+// from the mesh, centred 1.5 and 1.6 mm from the tips, measured), and `hexbite mesh --landmarks` names them,
+// in the text and in --json.
+TEST(MeshCommand, NamesTooThinPartsByLandmark) {
+  const std::string dir = test::temp_dir();
+  const GeneratedMandible g = generate_mandible({});
+  write_surface(dir + "/m.stl", g.surface);
+  write_landmarks(dir + "/m.yaml", g.landmarks, "test");
+  auto r = test::run_hexbite({"mesh", dir + "/m.stl", "--method", "grid", "--target-hexes", "1000",
+                              "--landmarks", dir + "/m.yaml", "-o", dir + "/m.vtu", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"landmarks\": \"" + dir + "/m.yaml\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"near\": ["), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"name\": \"left_coronoid_tip\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"name\": \"right_coronoid_tip\""), std::string::npos) << r.out;
+  r = test::run_hexbite({"mesh", dir + "/m.stl", "--method", "grid", "--target-hexes", "1000", "--landmarks",
+                         dir + "/m.yaml", "-o", dir + "/m.vtu"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("left_coronoid_tip ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("right_coronoid_tip ("), std::string::npos) << r.out;
+  // A landmark file that cannot be read is an input error before any meshing.
+  r = test::run_hexbite({"mesh", dir + "/m.stl", "--method", "grid", "--landmarks", dir + "/missing.yaml",
+                         "-o", dir + "/x.vtu"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_FALSE(std::ifstream(dir + "/x.vtu").good());
 }
 
 TEST(MeshCommand, RejectsBadTargetsMethodAndOpenSurfaces) {

@@ -200,6 +200,12 @@ TEST(HexOptimize, WorstElementPassRaisesTheWorstHex) {
   EXPECT_EQ(summarize_quality(m).inverted, 0);
   for (std::size_t v = 0; v < m.vertices.size(); ++v)
     if (!movable[v]) EXPECT_EQ(m.vertices[v], start.vertices[v]);
+  // A second round of both stages starts where the first ended and never lowers the worst measure.
+  HexMesh twice = start;
+  options.worst_element_rounds = 2;
+  EXPECT_GT(improve_worst_elements(twice, movable, sliding, nullptr, options), sweeps);
+  EXPECT_GE(worst_measure(twice), after);
+  EXPECT_EQ(summarize_quality(twice).inverted, 0);
   // Off by default: optimize_hex_mesh without the option leaves the pass out.
   HexMesh again = start;
   EXPECT_EQ(optimize_hex_mesh(again, nullptr, boundary).worst_element_sweeps, 0);
