@@ -27,6 +27,7 @@ using vec3::sub;
 namespace {
 
 constexpr double kMinNormalAgreement = 0.2;
+constexpr double kSnapQuality = 0.3;  // feature snapping may lower a quad corner's scaled Jacobian to this
 
 Vec3 unit(const Vec3& a) {
   const double n = norm(a);
@@ -642,6 +643,128 @@ void unfold(QuadSurface& fine, const PlacementSurface& s, const std::vector<char
   }
 }
 
+// Scaled Jacobian of a quad corner against the input: the sine of the corner angle, negative when the
+// corner normal opposes the input normal where the corner node sits.
+double corner_jacobian(const QuadSurface& q, const std::array<int, 4>& quad, int k,
+                       const std::vector<Vec3>& surface_normal) {
+  const Vec3& p = q.vertices[quad[k]];
+  const Vec3 a = sub(q.vertices[quad[(k + 1) % 4]], p), b = sub(q.vertices[quad[(k + 3) % 4]], p);
+  const double l = norm(a) * norm(b);
+  return l > 0 ? dot(cross(a, b), surface_normal[quad[k]]) / l : -1.0;
+}
+
+// Feature snapping (step 8): the input vertices farther than threshold_mm from the quads (cusp tips,
+// condyle poles, crests that the quads cut off), farthest first, pull a free node of their nearest quad
+// (nearest node first) onto themselves. A move is kept when it keeps the smallest corner scaled Jacobian of
+// the node's quads above kSnapQuality or above what it was, and lowers the local error: the largest
+// distance of the vertex and of the input vertices charged to those quads (nearest to them) to them, and
+// of their inner sample points to the input. Snapped nodes stay fixed. Each round re-measures; up to
+// `rounds` rounds, stopping when a round moves nothing.
+void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<char>& fixed, int rounds,
+                   double threshold_mm, std::vector<Vec3>* surface_normal) {
+  std::vector<std::vector<int>> vertex_quads(fine.vertices.size());
+  for (std::size_t q = 0; q < fine.quads.size(); ++q)
+    for (int v : fine.quads[q]) vertex_quads[v].push_back(static_cast<int>(q));
+  auto distance_to_quads = [&](const Vec3& p, const std::vector<int>& quads) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int q : quads) {
+      const auto& quad = fine.quads[q];
+      const Vec3 centre = bilinear(fine, quad, 0.5, 0.5);
+      for (int k = 0; k < 4; ++k)
+        best = std::min(best, norm(sub(p, closest_on_triangle(p, fine.vertices[quad[k]],
+                                                              fine.vertices[quad[(k + 1) % 4]], centre))));
+    }
+    return best;
+  };
+  // The largest distance of a quad's inner sample points to the input.
+  auto sampled_error = [&](int q) {
+    double e = 0;
+    for (int b = 1; b <= 3; ++b)
+      for (int a = 1; a <= 3; ++a)
+        e = std::max(e, s.projector.distance(bilinear(fine, fine.quads[q], a / 4.0, b / 4.0)));
+    return e;
+  };
+  for (int round = 0; round < rounds; ++round) {
+    TriSurface quad_triangles;
+    quad_triangles.vertices = fine.vertices;
+    for (const auto& quad : fine.quads) {
+      const int centre = static_cast<int>(quad_triangles.vertices.size());
+      quad_triangles.vertices.push_back(bilinear(fine, quad, 0.5, 0.5));
+      for (int k = 0; k < 4; ++k) quad_triangles.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
+    }
+    const SurfaceProjector quad_projector(quad_triangles);
+    std::vector<std::vector<int>> charged(fine.quads.size());
+    std::vector<std::pair<double, int>> far;
+    for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
+      const SurfacePoint sp = quad_projector.closest(s.surface.vertices[i]);
+      charged[sp.triangle / 4].push_back(static_cast<int>(i));
+      if (sp.distance > threshold_mm) far.push_back({-sp.distance, static_cast<int>(i)});
+    }
+    std::sort(far.begin(), far.end());
+    std::vector<double> sample_error(fine.quads.size());
+    for (std::size_t q = 0; q < fine.quads.size(); ++q) sample_error[q] = sampled_error(static_cast<int>(q));
+    std::vector<char> touched(fine.quads.size(), 0);
+    int moved = 0;
+    for (const auto& [negative_distance, i] : far) {
+      const Vec3& p = s.surface.vertices[i];
+      const SurfacePoint sp = quad_projector.closest(p);
+      const int q0 = sp.triangle / 4;
+      if (touched[q0]) continue;  // its quads changed this round: the distances are stale
+      // The free nodes of that quad, nearest first; the first whose move is kept.
+      std::array<int, 4> nodes = fine.quads[q0];
+      std::sort(nodes.begin(), nodes.end(), [&](int x, int y) {
+        return std::pair{norm(sub(fine.vertices[x], p)), x} < std::pair{norm(sub(fine.vertices[y], p)), y};
+      });
+      for (int v : nodes) {
+        if (fixed[v]) continue;
+        const std::vector<int>& quads = vertex_quads[v];
+        // Local error: the largest distance of p and of the input vertices charged to v's quads to those
+        // quads, and of the quads' sampled points to the input (cached per quad); local quality: the
+        // smallest corner scaled Jacobian of v's quads.
+        auto charged_error = [&]() {
+          double e = distance_to_quads(p, quads);
+          for (int q : quads)
+            for (int j : charged[q]) e = std::max(e, distance_to_quads(s.surface.vertices[j], quads));
+          return e;
+        };
+        auto quality = [&]() {
+          double m = 1.0;
+          for (int q : quads)
+            for (int k = 0; k < 4; ++k)
+              m = std::min(m, corner_jacobian(fine, fine.quads[q], k, *surface_normal));
+          return m;
+        };
+        double before = charged_error();
+        for (int q : quads) before = std::max(before, sample_error[q]);
+        const double before_quality = quality();
+        const Vec3 old_point = fine.vertices[v], old_normal = (*surface_normal)[v];
+        fine.vertices[v] = p;
+        (*surface_normal)[v] = s.projector.closest(p).normal;
+        if (quality() > std::min(before_quality, kSnapQuality) && charged_error() < before - 1e-6) {
+          std::vector<double> after_samples;
+          double after = 0;
+          for (int q : quads) {
+            after_samples.push_back(sampled_error(q));
+            after = std::max(after, after_samples.back());
+          }
+          if (after < before - 1e-6) {
+            for (std::size_t k = 0; k < quads.size(); ++k) {
+              sample_error[quads[k]] = after_samples[k];
+              touched[quads[k]] = 1;
+            }
+            fixed[v] = 1;
+            ++moved;
+            break;
+          }
+        }
+        fine.vertices[v] = old_point;
+        (*surface_normal)[v] = old_normal;
+      }
+    }
+    if (moved == 0) break;
+  }
+}
+
 std::string point_text(const Vec3& p) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
@@ -741,12 +864,13 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
       report.landmark_vertices.push_back(best);
     }
 
-  // 6. Relaxation on the target.
+  // 6-8. Relaxation, untangling and feature snapping on the target.
   relax(fine, target, fixed, options.relax_sweeps, &surface_normal);
   unfold(fine, target, fixed, options.unfold_sweeps, &surface_normal);
+  snap_features(fine, target, fixed, options.snap_rounds, options.snap_threshold_mm, &surface_normal);
   progress.update(0.9, "relaxed");
 
-  // 7. Fidelity.
+  // 9. Fidelity.
   const QuadEdges fine_edges = build_quad_edges(fine.quads);
   double edge_sum = 0;
   for (const auto& e : fine_edges.edges) edge_sum += norm(sub(fine.vertices[e[1]], fine.vertices[e[0]]));
