@@ -1,6 +1,5 @@
 #include "app/mesh_sheets_surface.h"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -14,44 +13,17 @@
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/landmarks.h"
+#include "mesher/mandible_sheet_mesher.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 #include "mesher/quad_surface_placement.h"
 #include "mesher/surface_check.h"
-#include "mesher/surface_projector.h"
 #include "mesher/units.h"
 #include "postprocess/quality_json.h"
 
 namespace hexbite {
 
 namespace {
-
-// Builds and checks the quad surface; the check failing is a defect of the template or its placement
-// (RunError), not of the user's input. `surface` receives the input triangulation (in mm).
-QuadSurface build_checked_quads(const MandibleQuadCommandOptions& o, MandibleQuadReport* report,
-                                QuadSurfaceReport* check, TriSurface* surface_out) {
-  const double scale = unit_to_mm(o.units);
-  TriSurface& surface = *surface_out;
-  surface = load_closed_surface(o.surface, scale);
-  std::unique_ptr<Landmarks> landmarks;
-  if (!o.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(o.landmarks, scale));
-  MandibleQuadOptions options;
-  options.target_quads = o.target_quads;
-  QuadSurface quads;
-  try {
-    quads = quad_surface_from_mandible(surface, landmarks.get(), o.landmarks, options, report);
-  } catch (const InputError& e) {
-    throw InputError("'" + o.surface + "': " + e.what());
-  }
-  *check = check_quad_surface(quads, o.surface + " (quad surface)");
-  if (!check->usable()) {
-    std::string problems;
-    for (const auto& p : check->problems) problems += "; " + p;
-    throw RunError("the quad surface built for '" + o.surface + "' fails its check" + problems +
-                   "; use --method grid for this surface");
-  }
-  return quads;
-}
 
 nlohmann::json quad_json(const MandibleQuadReport& r, const QuadSurfaceReport& check) {
   nlohmann::json landmark_nodes = nlohmann::json::object();
@@ -121,75 +93,22 @@ std::string histogram_text(const std::vector<int>& counts) {
   return s.empty() ? "none" : s;
 }
 
-// "hex 12 at (1.0, 2.0, 3.0) mm, ...": the first 10 inverted hexes with their centroids.
-std::string inverted_list(const HexMesh& mesh, const std::vector<int>& inverted) {
-  std::ostringstream out;
-  const std::size_t shown = std::min<std::size_t>(inverted.size(), 10);
-  for (std::size_t i = 0; i < shown; ++i) {
-    Vec3 c{0, 0, 0};
-    for (int v : mesh.hexes[inverted[i]])
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "%shex %d at (%.1f, %.1f, %.1f) mm", i ? ", " : "", inverted[i], c[0],
-                  c[1], c[2]);
-    out << buf;
-  }
-  if (shown < inverted.size()) out << " and " << inverted.size() - shown << " more";
-  return out.str();
-}
-
-// A pillow layer under the boundary: every boundary vertex v < quads.vertices.size() gets an inner copy,
-// which takes its place in the hexes, and every boundary quad a hex between it and the copies of its
-// corners. The boundary stays the quad surface (the same vertex ids and quads); no hex has more than one
-// face on it afterwards, which removes the hexes wrapped around thin rims and tips. The copy starts 40 % of
-// the way from v to the mean centroid of v's hexes.
-void pillow(HexMesh& mesh, const QuadSurface& quads) {
-  const int n = static_cast<int>(quads.vertices.size());
-  std::vector<Vec3> inward(n, Vec3{0, 0, 0});
-  std::vector<int> count(n, 0);
-  for (const auto& hex : mesh.hexes) {
-    Vec3 c{0, 0, 0};
-    for (int v : hex)
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
-    for (int v : hex)
-      if (v < n) {
-        for (int a = 0; a < 3; ++a) inward[v][a] += c[a];
-        ++count[v];
-      }
-  }
-  const int first = static_cast<int>(mesh.vertices.size());
-  for (int v = 0; v < n; ++v) {
-    Vec3 p = mesh.vertices[v];
-    if (count[v] > 0)
-      for (int a = 0; a < 3; ++a) p[a] += 0.4 * (inward[v][a] / count[v] - p[a]);
-    mesh.vertices.push_back(p);
-  }
-  for (auto& hex : mesh.hexes)
-    for (int& v : hex)
-      if (v < n) v += first;
-  for (const auto& q : quads.quads)
-    mesh.hexes.push_back({q[0] + first, q[1] + first, q[2] + first, q[3] + first, q[0], q[1], q[2], q[3]});
-}
-
-// The optimizer for the pillowed mesh, whose boundary nodes slide on the input surface. Measured on both
-// mandibles (docs/mandible_quads.md): a tether of a quarter edge (the default half edge lets nodes leave the
-// condyles and coronoid tips, 1 to 2 mm more Hausdorff distance for 0.006 to 0.02 more mean scaled
-// Jacobian) and the worst-element pass, which raises the smallest scaled Jacobian.
-OptimizeOptions surface_optimizer_options() {
-  OptimizeOptions o;
-  o.boundary_tether = 0.25;
-  o.worst_element_threshold = 0.3;
-  o.scaled_jacobian_sweeps = 10;
-  return o;
-}
-
 }  // namespace
 
 void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
+  const double scale = unit_to_mm(o.units);
+  const TriSurface surface = load_closed_surface(o.surface, scale);
+  std::unique_ptr<Landmarks> landmarks;
+  if (!o.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(o.landmarks, scale));
   MandibleQuadReport report;
   QuadSurfaceReport check;
-  TriSurface surface;
-  const QuadSurface quads = build_checked_quads(o, &report, &check, &surface);
+  QuadSurface quads;
+  try {
+    quads = checked_mandible_quads(surface, landmarks.get(), o.target_quads, o.surface, o.landmarks, &report,
+                                   &check);
+  } catch (const RunError& e) {
+    throw RunError(std::string(e.what()) + "; use --method grid for this surface");
+  }
   write_quad_obj(o.output, quads);
   if (o.json) {
     nlohmann::json j = quad_json(report, check);
@@ -209,44 +128,30 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     throw InputError("--target-hexes " + std::to_string(o.target_hexes) +
                      " is out of range: give a number from 8 to 5,000,000");
   const auto t0 = std::chrono::steady_clock::now();
-  const EliminationOrder order = parse_elimination_order(o.order);
-  MandibleQuadCommandOptions qo = o.quad;
-  qo.target_quads = quads_for_target_hexes(o.target_hexes);
-  MandibleQuadReport quad_report;
-  QuadSurfaceReport check;
-  TriSurface surface;
-  const QuadSurface quads = build_checked_quads(qo, &quad_report, &check, &surface);
-
-  // The boundary quads are our own construction, so the optimizer may let them slide on the input: only the
-  // landmark nodes stay where they are (cycle elimination keeps the quad vertices' ids). The sheet mesher
-  // itself only smooths the interior (its optimizer would hold the whole boundary fixed).
-  SheetMeshOptions options;
-  options.elimination.order = order;
-  options.optimize = false;
-  SheetMeshReport report;
+  const MandibleQuadCommandOptions& qo = o.quad;
+  MandibleSheetOptions options;
+  options.target_hexes = o.target_hexes;
+  options.order = parse_elimination_order(o.order);
+  options.surface_name = qo.surface;
+  options.landmark_file = qo.landmarks;
+  const double scale = unit_to_mm(qo.units);
+  const TriSurface surface = load_closed_surface(qo.surface, scale);
+  std::unique_ptr<Landmarks> landmarks;
+  if (!qo.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(qo.landmarks, scale));
+  MandibleSheetReport sheet_report;
   HexMesh mesh;
   try {
-    mesh = mesh_by_cycle_elimination(quads, options, &report);
-  } catch (const InputError& e) {
-    throw RunError("cycle elimination on the quad surface of '" + qo.surface + "' (" +
-                   std::to_string(quad_report.quads) + " quads): " + e.what() + "; use --method grid");
+    mesh = mesh_mandible_by_sheets(surface, landmarks.get(), options, &sheet_report);
   } catch (const RunError& e) {
-    throw RunError("cycle elimination on the quad surface of '" + qo.surface + "' (" +
-                   std::to_string(quad_report.quads) + " quads): " + e.what() + "; use --method grid");
+    throw RunError(std::string(e.what()) + "; use --method grid");
   }
-  const auto t_embed = std::chrono::steady_clock::now();
-  pillow(mesh, quads);
-  std::vector<char> fixed(mesh.vertices.size(), 0);
-  for (int v : quad_report.landmark_vertices) fixed[v] = 1;
-  const SurfaceProjector projector(surface);
-  report.optimize = optimize_hex_mesh(mesh, &projector, fixed, surface_optimizer_options());
-  report.hexes = static_cast<int>(mesh.hexes.size());
-  report.interior_vertices = static_cast<int>(mesh.vertices.size() - quads.vertices.size());
-  report.quality = summarize_quality(mesh);
-  const MeshFidelity fidelity = measure_fidelity(mesh, projector);
-  report.seconds_embedding += seconds_since(t_embed);
+  const EliminationOrder order = options.order;
+  const MandibleQuadReport& quad_report = sheet_report.quad;
+  const QuadSurfaceReport& check = sheet_report.quad_check;
+  const SheetMeshReport& report = sheet_report.sheets;
+  const MeshFidelity& fidelity = sheet_report.fidelity;
   const double total_seconds = seconds_since(t0);
-  const bool valid = report.quality.inverted == 0;
+  const bool valid = sheet_report.inverted == 0;
   const bool write = valid || o.allow_invalid;
   if (write) write_vtu(qo.output, mesh);
   const QualitySummary& q = report.quality;
@@ -268,7 +173,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     j["external_sheets"] = report.external_sheets;
     j["internal_sheets"] = report.internal_sheets;
     j["hexes"] = report.hexes;
-    j["pillow_hexes"] = report.quads;
+    j["pillow_hexes"] = sheet_report.pillow_hexes;
     j["interior_nodes"] = report.interior_vertices;
     j["seconds"] = {{"quad_surface", quad_report.seconds},
                     {"elimination", report.seconds_elimination},
@@ -291,7 +196,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
         "%d hexes with the pillow layer (%d under the quads), %d interior nodes\n",
         elimination_order_name(order), report.eliminations, report.eliminations_single,
         report.eliminations_k_step, report.external_sheets, report.internal_sheets, report.hexes,
-        report.quads, report.interior_vertices);
+        sheet_report.pillow_hexes, report.interior_vertices);
     out << line;
     out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
         << q.node_degree.max_edges << "\n";
@@ -316,7 +221,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   }
   if (!valid && !o.allow_invalid)
     throw RunError(std::to_string(q.inverted) +
-                   " hexes stay inverted after optimization: " + inverted_list(mesh, q.inverted_hexes) +
+                   " hexes stay inverted after optimization: " + hex_list_text(mesh, q.inverted_hexes) +
                    "; no mesh written (--allow-invalid writes it anyway)");
   if (!qo.json) info("wrote " + qo.output);
 }

@@ -1,8 +1,8 @@
 // The sheet mesher on a triangulated mandible: `hexbite quad from-mandible SURFACE -o Q.obj` (the quad
 // surface only) and `hexbite mesh SURFACE --method sheets -o mesh.vtu` (quad surface, then cycle
 // elimination, a pillow layer, embedding and optimization with the boundary sliding on the input). The quad
-// surface comes from mesher/quad_surface_placement.h; cmd_quad.cc and cmd_mesh.cc only forward their options
-// here.
+// surface and the mesh come from mesher/mandible_sheet_mesher.h; this file loads the input, prints the
+// reports (text or JSON) and writes the result. cmd_quad.cc and cmd_mesh.cc only forward their options here.
 #pragma once
 
 #include <string>
@@ -26,14 +26,12 @@ void run_quad_from_mandible(const MandibleQuadCommandOptions& options);
 struct MeshSheetsSurfaceOptions {
   MandibleQuadCommandOptions quad;  // quad.output is the .vtu
   long target_hexes = 2500;         // sets quad.target_quads through quads_for_target_hexes()
-  std::string order = "fewest-hexes";
+  std::string order = "geometric";  // parse_elimination_order()
   bool allow_invalid = false;
 };
 
-// mesh SURFACE --method sheets: quad surface, cycle elimination (the sheet mesher smooths the interior
-// only), then a pillow layer under the quad surface (every boundary quad gets one hex, so no hex keeps two
-// faces on a thin rim or tip) and optimize_hex_mesh with the input's SurfaceProjector: the quad surface
-// being our own construction, its nodes slide on the input, only the landmark nodes stay fixed. Then the
+// mesh SURFACE --method sheets: mesh_mandible_by_sheets() (quad surface, cycle elimination, a pillow layer
+// and an optimization with the boundary sliding on the input, only the landmark nodes fixed), then the
 // report (the keys of the sheet mesher's report, `pillow_hexes`, the quad surface's, and `fidelity` of the
 // slid boundary against the input) and the mesh written atomically; RunError listing the inverted hexes
 // when some remain, unless allow_invalid. (`mesh --quad-surface Q.obj --method sheets`, app/mesh_sheets.cc,

@@ -291,6 +291,7 @@ json results_json(const RunResult& r, double seconds_output) {
   j.erase("dofs");
   j["scenario"] = s.name;
   j["scenario_file"] = s.path;
+  j["mesh_method"] = s.mesh.method == MeshMethod::kSheets ? "sheets" : "grid";
   const MeshFidelity& f = r.fidelity;
   j["mesh"] = {{"hexes", coarse.mesh.hexes.size()},
                {"nodes", coarse.mesh.vertices.size()},

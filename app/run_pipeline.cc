@@ -13,6 +13,7 @@
 #include "mesher/hex_refine.h"
 #include "mesher/landmarks.h"
 #include "mesher/mandible_generator.h"
+#include "mesher/mandible_sheet_mesher.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
 
@@ -55,6 +56,55 @@ Geometry build_geometry(const Scenario& s) {
   }
   if (!s.landmarks.file.empty()) g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
   return g;
+}
+
+// `method: grid`. A mesh that stays inverted cannot be solved on.
+HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity) {
+  GridMeshOptions options;
+  options.target_hexes = s.mesh.target_hexes;
+  GridMeshReport report;
+  HexMesh mesh = grid_mesh(geometry.surface, options, &report);
+  *fidelity = report.fidelity;
+  if (report.optimize.inverted > 0)
+    throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
+                   " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
+                   "; try another target (hexbite mesh shows where)");
+  return mesh;
+}
+
+// `method: sheets`: the mandible template placed by the geometry's landmarks (the built-in mandible's own or
+// the landmark file's), or by the surface's extreme points when there are none. Landmarks that lack the
+// template's points, or a bone that is not a mandible, are the scenario's fault (InputError at `method`,
+// which a scenario asking for sheets has written).
+HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity) {
+  const bool has_landmarks = !geometry.landmarks.points.empty() || !geometry.landmarks.muscles.empty();
+  MandibleSheetOptions options;
+  options.target_hexes = s.mesh.target_hexes;
+  options.surface_name =
+      s.geometry.source == GeometrySource::kMandible ? "the built-in mandible" : s.geometry.file;
+  options.landmark_file = !s.landmarks.file.empty() ? s.landmarks.file
+                          : has_landmarks           ? "the built-in mandible's landmarks"
+                                                    : "";
+  MandibleSheetReport report;
+  HexMesh mesh;
+  try {
+    mesh = mesh_mandible_by_sheets(geometry.surface, has_landmarks ? &geometry.landmarks : nullptr, options,
+                                   &report);
+  } catch (const InputError& e) {
+    throw InputError(
+        s.mesh.method_at.str() + ": mesh.method 'sheets' cannot place its mandible template: " + e.what() +
+        "; give landmarks with the template's points, or use method: grid for a bone that is not a "
+        "whole mandible");
+  } catch (const RunError& e) {
+    throw RunError(std::string("the sheet mesher failed: ") + e.what() + "; use method: grid");
+  }
+  *fidelity = report.fidelity;
+  if (report.inverted > 0)
+    throw RunError("the sheet mesher left " + std::to_string(report.inverted) +
+                   " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) + ": " +
+                   hex_list_text(mesh, report.sheets.quality.inverted_hexes) +
+                   "; try another target or method: grid");
+  return mesh;
 }
 
 // Degrees of freedom of vector FE_Q(degree) on the mesh: 3 per vertex, and for Q2 also 3 per edge, face and
@@ -220,11 +270,6 @@ std::vector<std::pair<int, Vec3>> consistent_nodal_forces(const HexMesh& mesh,
 RunResult run_pipeline(Scenario scenario, int levels) {
   const auto start = std::chrono::steady_clock::now();
   RunResult result;
-  if (scenario.mesh.method == MeshMethod::kSheets)
-    throw InputError((scenario.mesh.method_at.file.empty() ? scenario.path : scenario.mesh.method_at.str()) +
-                     ": mesh.method 'sheets' (the seed paper's cycle elimination) is not available yet; use "
-                     "method: grid");
-
   Geometry geometry;
   {
     Progress progress("geometry");
@@ -240,16 +285,10 @@ RunResult run_pipeline(Scenario scenario, int levels) {
   {
     Progress progress("mesh");
     const auto t = std::chrono::steady_clock::now();
-    GridMeshOptions options;
-    options.target_hexes = scenario.mesh.target_hexes;
-    GridMeshReport report;
-    coarse = grid_mesh(geometry.surface, options, &report);
+    coarse = scenario.mesh.method == MeshMethod::kSheets
+                 ? mesh_by_sheets(scenario, geometry, &result.fidelity)
+                 : mesh_by_grid(scenario, geometry, &result.fidelity);
     seconds_mesh = seconds_since(t);
-    result.fidelity = report.fidelity;
-    if (report.optimize.inverted > 0)
-      throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
-                     " inverted hexes at mesh.target_hexes = " + std::to_string(scenario.mesh.target_hexes) +
-                     "; try another target (hexbite mesh shows where)");
     progress.finish(std::to_string(coarse.hexes.size()) + " hexes");
   }
   result.levels.push_back(prepare_level(scenario, 0, coarse));
