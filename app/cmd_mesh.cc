@@ -23,6 +23,7 @@
 #include "common/progress.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
 #include "mesher/landmarks.h"
 #include "mesher/surface_check.h"
 #include "mesher/units.h"
@@ -161,23 +162,6 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   return j;
 }
 
-// "hex 12 at (1.0, 2.0, 3.0) mm, ...": the inverted hexes with their centroids, at most 20 of them.
-std::string inverted_list(const HexMesh& mesh, const std::vector<int>& inverted) {
-  std::ostringstream out;
-  const std::size_t shown = std::min<std::size_t>(inverted.size(), 20);
-  for (std::size_t i = 0; i < shown; ++i) {
-    Vec3 c{0, 0, 0};
-    for (int v : mesh.hexes[inverted[i]])
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "%shex %d at (%.2f, %.2f, %.2f) mm", i ? ", " : "", inverted[i], c[0],
-                  c[1], c[2]);
-    out << buf;
-  }
-  if (shown < inverted.size()) out << " and " << inverted.size() - shown << " more";
-  return out.str();
-}
-
 void run_mesh(const MeshOptions& o) {
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
     return run_mesh_sheets_surface(
@@ -209,7 +193,7 @@ void run_mesh(const MeshOptions& o) {
   else if (!is_quiet())
     std::cout << report_text(o, mesh, report);
   if (!valid) {
-    const std::string list = inverted_list(mesh, final_quality.inverted_hexes);
+    const std::string list = hex_list_text(mesh, final_quality.inverted_hexes);
     if (o.allow_invalid) {
       std::cerr << "hexbite: warning: wrote " << o.output << " with " << final_quality.inverted
                 << " inverted hexes on purpose (--allow-invalid): " << list << '\n';

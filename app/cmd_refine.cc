@@ -16,6 +16,7 @@
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
@@ -145,24 +146,6 @@ nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, boo
   return j;
 }
 
-// "hex 12 (in input hex 1) at (1.00, 2.00, 3.00) mm, ...": at most 20 inverted hexes with their centroids.
-std::string inverted_list(const HexMesh& mesh, const std::vector<int>& inverted, int levels) {
-  std::ostringstream out;
-  const std::size_t shown = std::min<std::size_t>(inverted.size(), 20);
-  for (std::size_t i = 0; i < shown; ++i) {
-    const int h = inverted[i];
-    Vec3 c{0, 0, 0};
-    for (int v : mesh.hexes[h])
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%shex %d (in input hex %d) at (%.2f, %.2f, %.2f) mm", i ? ", " : "", h,
-                  h >> (3 * levels), c[0], c[1], c[2]);
-    out << buf;
-  }
-  if (shown < inverted.size()) out << " and " << inverted.size() - shown << " more";
-  return out.str();
-}
-
 void run_refine(const RefineCliOptions& o) {
   const HexMesh coarse = read_vtu(o.mesh);
   const long long refined = static_cast<long long>(coarse.hexes.size()) << (3 * o.levels);
@@ -191,8 +174,11 @@ void run_refine(const RefineCliOptions& o) {
     if (report.before.inverted > 0)
       cause = " (the input already has " + std::to_string(report.before.inverted) +
               " inverted hexes: check it with hexbite quality)";
-    throw RunError(std::to_string(report.after.inverted) + " hexes of the refined mesh are inverted" + cause +
-                   ": " + inverted_list(fine, report.after.inverted_hexes, o.levels) + "; no mesh written");
+    throw RunError(
+        std::to_string(report.after.inverted) + " hexes of the refined mesh are inverted" + cause + ": " +
+        hex_list_text(fine, report.after.inverted_hexes, 20,
+                      [&o](int h) { return " (in input hex " + std::to_string(h >> (3 * o.levels)) + ")"; }) +
+        "; no mesh written");
   }
   if (!o.json) info("wrote " + o.output);
 }

@@ -26,22 +26,12 @@ std::string histogram_text(const std::vector<int>& counts) {
 std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
   std::ostringstream out;
   char line[256];
-  const QualitySummary& q = r.quality;
   out << "Meshed " << o.quad_surface << " (cycle elimination, " << elimination_order_name(r.order)
       << "): " << r.quads << " boundary quads, " << r.chords << " chords, " << r.eliminations
       << " eliminations (" << r.eliminations_single << " single, " << r.eliminations_k_step << " k-step; "
       << r.external_sheets << " external, " << r.internal_sheets << " internal sheets), " << r.decompositions
       << " decompositions, " << r.hexes << " hexes, " << r.interior_vertices << " interior nodes\n";
-  out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
-      << q.node_degree.max_edges << "\n";
-  out << "interior node degrees (hexes): " << histogram_text(q.node_degree.hexes) << "; maximum "
-      << q.node_degree.max_hexes << "\n";
-  std::snprintf(line, sizeof line,
-                "quality: scaled Jacobian min %.4f mean %.4f max %.4f; condition (cube = 3) min %.3f mean "
-                "%.3f max %.3f; Oddy mean %.3f max %.3f; %d inverted\n",
-                q.scaled_jacobian.min, q.scaled_jacobian.mean, q.scaled_jacobian.max, q.condition.min,
-                q.condition.mean, q.condition.max, q.oddy.mean, q.oddy.max, q.inverted);
-  out << line;
+  out << sheet_quality_text(r.quality);
   std::snprintf(line, sizeof line, "time: elimination %.2f s, embedding %.2f s\n", r.seconds_elimination,
                 r.seconds_embedding);
   out << line;
@@ -74,20 +64,8 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
     j["quad_surface"] = o.quad_surface;
     j["method"] = "sheets";
     j["order"] = elimination_order_name(order);
-    j["quads"] = report.quads;
-    j["chords"] = report.chords;
-    j["eliminations"] = {{"single", report.eliminations_single}, {"k_step", report.eliminations_k_step}};
-    j["sheets"] = {{"external", report.external_sheets}, {"internal", report.internal_sheets}};
-    j["eliminations_single"] = report.eliminations_single;
-    j["eliminations_k_step"] = report.eliminations_k_step;
-    j["chords_eliminated"] = report.chords_eliminated;
-    j["external_sheets"] = report.external_sheets;
-    j["internal_sheets"] = report.internal_sheets;
-    j["decompositions"] = report.decompositions;
-    j["hexes"] = report.hexes;
-    j["interior_nodes"] = report.interior_vertices;
+    add_sheet_report_json(report, j);
     j["seconds"] = {{"elimination", report.seconds_elimination}, {"embedding", report.seconds_embedding}};
-    j["quality"] = quality_to_json(report.quality);
     j["output"] = write ? nlohmann::json(o.output) : nlohmann::json();
     std::cout << j.dump(2) << '\n';
   } else if (!is_quiet()) {
@@ -98,6 +76,38 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
         std::to_string(report.quality.inverted) +
         " hexes stay inverted after optimization; no mesh written (--allow-invalid writes it anyway)");
   if (!o.json) info("wrote " + o.output);
+}
+
+void add_sheet_report_json(const SheetMeshReport& r, nlohmann::json& j) {
+  j["quads"] = r.quads;
+  j["chords"] = r.chords;
+  j["eliminations"] = {{"single", r.eliminations_single}, {"k_step", r.eliminations_k_step}};
+  j["sheets"] = {{"external", r.external_sheets}, {"internal", r.internal_sheets}};
+  j["eliminations_single"] = r.eliminations_single;
+  j["eliminations_k_step"] = r.eliminations_k_step;
+  j["chords_eliminated"] = r.chords_eliminated;
+  j["external_sheets"] = r.external_sheets;
+  j["internal_sheets"] = r.internal_sheets;
+  j["decompositions"] = r.decompositions;
+  j["hexes"] = r.hexes;
+  j["interior_nodes"] = r.interior_vertices;
+  j["quality"] = quality_to_json(r.quality);
+}
+
+std::string sheet_quality_text(const QualitySummary& q) {
+  std::ostringstream out;
+  out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
+      << q.node_degree.max_edges << "\n";
+  out << "interior node degrees (hexes): " << histogram_text(q.node_degree.hexes) << "; maximum "
+      << q.node_degree.max_hexes << "\n";
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "quality: scaled Jacobian min %.4f mean %.4f max %.4f; condition (cube = 3) min %.3f mean "
+                "%.3f max %.3f; Oddy mean %.3f max %.3f; %d inverted\n",
+                q.scaled_jacobian.min, q.scaled_jacobian.mean, q.scaled_jacobian.max, q.condition.min,
+                q.condition.mean, q.condition.max, q.oddy.mean, q.oddy.max, q.inverted);
+  out << line;
+  return out.str();
 }
 
 }  // namespace hexbite

@@ -2,7 +2,10 @@
 // mesher/cycle_elimination.h) behind the mesh command; cmd_mesh.cc only forwards its options here.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
+
+#include "mesher/cycle_elimination.h"
 
 namespace hexbite {
 
@@ -18,5 +21,13 @@ struct MeshSheetsOptions {
 // surface or option, RunError when no chord is feasible or hexes stay inverted (then nothing is written
 // unless allow_invalid).
 void run_mesh_sheets(const MeshSheetsOptions& options);
+
+// Shared by both sheets commands (this one and app/mesh_sheets_surface.h). The report's counts and quality
+// as JSON keys: quads, chords, eliminations {single, k_step}, sheets {external, internal},
+// eliminations_single, eliminations_k_step, chords_eliminated, external_sheets, internal_sheets,
+// decompositions, hexes, interior_nodes, quality.
+void add_sheet_report_json(const SheetMeshReport& report, nlohmann::json& j);
+// The interior node degree lines (edges, hexes) and the quality line, each ending in a newline.
+std::string sheet_quality_text(const QualitySummary& quality);
 
 }  // namespace hexbite

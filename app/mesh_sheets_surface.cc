@@ -7,11 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/mesh_sheets.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/cycle_elimination.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
 #include "mesher/landmarks.h"
 #include "mesher/mandible_sheet_mesher.h"
 #include "mesher/quad_check.h"
@@ -19,7 +21,6 @@
 #include "mesher/quad_surface_placement.h"
 #include "mesher/surface_check.h"
 #include "mesher/units.h"
-#include "postprocess/quality_json.h"
 
 namespace hexbite {
 
@@ -84,13 +85,6 @@ std::string quad_text(const std::string& surface, const MandibleQuadReport& r,
                 r.worst_surface_point[1], r.worst_surface_point[2]);
   out << line;
   return out.str();
-}
-
-std::string histogram_text(const std::vector<int>& counts) {
-  std::string s;
-  for (std::size_t d = 0; d < counts.size(); ++d)
-    if (counts[d] > 0) s += (s.empty() ? "" : ", ") + std::to_string(d) + ": " + std::to_string(counts[d]);
-  return s.empty() ? "none" : s;
 }
 
 }  // namespace
@@ -163,23 +157,12 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     j["order"] = elimination_order_name(order);
     j["target_hexes"] = o.target_hexes;
     j["quad_surface"] = quad_json(quad_report, check);
-    j["quads"] = report.quads;
-    j["chords"] = report.chords;
-    j["eliminations"] = {{"single", report.eliminations_single}, {"k_step", report.eliminations_k_step}};
-    j["sheets"] = {{"external", report.external_sheets}, {"internal", report.internal_sheets}};
-    j["eliminations_single"] = report.eliminations_single;
-    j["eliminations_k_step"] = report.eliminations_k_step;
-    j["chords_eliminated"] = report.chords_eliminated;
-    j["external_sheets"] = report.external_sheets;
-    j["internal_sheets"] = report.internal_sheets;
-    j["hexes"] = report.hexes;
+    add_sheet_report_json(report, j);
     j["pillow_hexes"] = sheet_report.pillow_hexes;
-    j["interior_nodes"] = report.interior_vertices;
     j["seconds"] = {{"quad_surface", quad_report.seconds},
                     {"elimination", report.seconds_elimination},
                     {"embedding", report.seconds_embedding},
                     {"total", total_seconds}};
-    j["quality"] = quality_to_json(q);
     j["fidelity"] = {{"hausdorff_mm", fidelity.hausdorff},
                      {"mesh_to_surface_mm", fidelity.hausdorff_mesh_to_surface},
                      {"surface_to_mesh_mm", fidelity.hausdorff_surface_to_mesh},
@@ -198,14 +181,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
         report.eliminations_k_step, report.external_sheets, report.internal_sheets, report.hexes,
         sheet_report.pillow_hexes, report.interior_vertices);
     out << line;
-    out << "interior node degrees (edges): " << histogram_text(q.node_degree.edges) << "; maximum "
-        << q.node_degree.max_edges << "\n";
-    std::snprintf(line, sizeof line,
-                  "quality: scaled Jacobian min %.4f mean %.4f max %.4f; condition (cube = 3) min %.3f mean "
-                  "%.3f max %.3f; Oddy mean %.3f max %.3f; %d inverted\n",
-                  q.scaled_jacobian.min, q.scaled_jacobian.mean, q.scaled_jacobian.max, q.condition.min,
-                  q.condition.mean, q.condition.max, q.oddy.mean, q.oddy.max, q.inverted);
-    out << line;
+    out << sheet_quality_text(q);
     std::snprintf(
         line, sizeof line,
         "mesh boundary (slid on the input) to the input: Hausdorff %.3f mm (mesh -> surface %.3f mm, "

@@ -10,6 +10,7 @@
 #include "common/progress.h"
 #include "mesher/ct_surface.h"
 #include "mesher/hex_boundary.h"
+#include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
 #include "mesher/landmarks.h"
 #include "mesher/mandible_generator.h"

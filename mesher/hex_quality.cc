@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <sstream>
 #include <utility>
 
 #include "mesher/hex_boundary.h"
@@ -146,6 +148,23 @@ QualitySummary summarize_quality(const HexMesh& mesh, const HexQualityField& fie
   s.condition_histogram = make_histogram(field.condition, 3.0, 13.0, 20);
   s.oddy_histogram = make_histogram(field.oddy, 0.0, 20.0, 20);
   return s;
+}
+
+std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes, std::size_t shown,
+                          const std::function<std::string(int)>& label) {
+  std::ostringstream out;
+  shown = std::min(shown, hexes.size());
+  for (std::size_t i = 0; i < shown; ++i) {
+    const int h = hexes[i];
+    Vec3 c{0, 0, 0};
+    for (int v : mesh.hexes[h])
+      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
+    char buf[128];
+    std::snprintf(buf, sizeof buf, " at (%.2f, %.2f, %.2f) mm", c[0], c[1], c[2]);
+    out << (i ? ", " : "") << "hex " << h << (label ? label(h) : std::string()) << buf;
+  }
+  if (shown < hexes.size()) out << " and " << hexes.size() - shown << " more";
+  return out.str();
 }
 
 }  // namespace hexbite

@@ -7,7 +7,9 @@
 // node_degrees and summarize_quality also sort the 12 m edges and 6 m faces, O(m log m) for m hexes.
 #pragma once
 
+#include <functional>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "mesher/hex_mesh.h"
@@ -79,5 +81,11 @@ struct QualitySummary {
 
 QualitySummary summarize_quality(const HexMesh& mesh);
 QualitySummary summarize_quality(const HexMesh& mesh, const HexQualityField& field);
+
+// "hex 12 at (1.00, 2.00, 3.00) mm, ...": the first `shown` of `hexes` (such as the inverted ones) with
+// their centroids, then "and N more"; `label(h)`, when given, is written after the hex number (for
+// instance " (in input hex 1)").
+std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes, std::size_t shown = 20,
+                          const std::function<std::string(int)>& label = {});
 
 }  // namespace hexbite

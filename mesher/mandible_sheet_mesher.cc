@@ -1,9 +1,6 @@
 #include "mesher/mandible_sheet_mesher.h"
 
-#include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <sstream>
 
 #include "common/error.h"
 #include "common/progress.h"
@@ -121,22 +118,6 @@ HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* land
   sheets.seconds_embedding += seconds_since(t_embed);
   report.inverted = sheets.quality.inverted;
   return mesh;
-}
-
-std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes) {
-  std::ostringstream out;
-  const std::size_t shown = std::min<std::size_t>(hexes.size(), 10);
-  for (std::size_t i = 0; i < shown; ++i) {
-    Vec3 c{0, 0, 0};
-    for (int v : mesh.hexes[hexes[i]])
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "%shex %d at (%.1f, %.1f, %.1f) mm", i ? ", " : "", hexes[i], c[0], c[1],
-                  c[2]);
-    out << buf;
-  }
-  if (shown < hexes.size()) out << " and " << hexes.size() - shown << " more";
-  return out.str();
 }
 
 }  // namespace hexbite

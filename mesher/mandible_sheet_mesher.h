@@ -71,7 +71,4 @@ QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* l
 HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* landmarks,
                                 const MandibleSheetOptions& options, MandibleSheetReport* report = nullptr);
 
-// "hex 12 at (1.0, 2.0, 3.0) mm, ...": the first 10 of `hexes` with their centroids, then "and N more".
-std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes);
-
 }  // namespace hexbite
