@@ -112,12 +112,19 @@ std::vector<double> local_edge_length(const HexMesh& mesh, const Adjacency& adj)
   return h;
 }
 
-// Two unit vectors spanning the plane orthogonal to the unit vector n.
-void tangent_frame(const Vec3& n, Vec3& t1, Vec3& t2) {
+// The directions a node may step in, as columns: the three axes, or for a node sliding on the surface
+// (foot = its closest surface point) two unit vectors spanning the tangent plane there.
+Eigen::Matrix<double, 3, Eigen::Dynamic> step_basis(const SurfacePoint* foot) {
+  if (!foot) return Eigen::Matrix3d::Identity();
+  const Vec3& n = foot->normal;
   const Vec3 helper = std::fabs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-  t1 = cross(n, helper);
+  Vec3 t1 = cross(n, helper);
   t1 = scale(t1, 1.0 / norm(t1));
-  t2 = cross(n, t1);
+  const Vec3 t2 = cross(n, t1);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, 2);
+  basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
+  basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
+  return basis;
 }
 
 // Energy over the hexes flagged active, with the gradient accumulated per vertex in hex order (fixed
@@ -233,17 +240,10 @@ bool untangle_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sl
     Eigen::Matrix3d neg_hess = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < n; ++i) neg_hess += (w[i] / z) * g[i] * g[i].transpose();
     neg_hess = mu * (neg_hess - grad * grad.transpose());
-    Eigen::Matrix3d basis = Eigen::Matrix3d::Identity();
-    int dims = 3;
-    if (sliding) {
-      const SurfacePoint sp = surface->closest(mesh.vertices[v]);
-      Vec3 t1, t2;
-      tangent_frame(sp.normal, t1, t2);
-      basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
-      basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
-      dims = 2;
-    }
-    const Eigen::MatrixXd b = basis.leftCols(dims);
+    SurfacePoint foot;
+    if (sliding) foot = surface->closest(mesh.vertices[v]);
+    const Eigen::MatrixXd b = step_basis(sliding ? &foot : nullptr);
+    const int dims = static_cast<int>(b.cols());
     const Eigen::VectorXd rg = b.transpose() * grad;
     Eigen::MatrixXd rh = b.transpose() * neg_hess * b;
     // Levenberg damping: the soft minimum is flat along directions no active corner constrains.
@@ -373,18 +373,10 @@ bool raise_worst_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool
     Eigen::Matrix3d neg_hess = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < m.size(); ++i) neg_hess += (w[i] / z) * g[i] * g[i].transpose();
     neg_hess = mu * (neg_hess - grad * grad.transpose());
-    Eigen::Matrix3d basis = Eigen::Matrix3d::Identity();
-    int dims = 3;
     SurfacePoint here;
-    if (sliding) {
-      here = surface->closest(mesh.vertices[v]);
-      Vec3 t1, t2;
-      tangent_frame(here.normal, t1, t2);
-      basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
-      basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
-      dims = 2;
-    }
-    const Eigen::MatrixXd b = basis.leftCols(dims);
+    if (sliding) here = surface->closest(mesh.vertices[v]);
+    const Eigen::MatrixXd b = step_basis(sliding ? &here : nullptr);
+    const int dims = static_cast<int>(b.cols());
     const Eigen::VectorXd rg = b.transpose() * grad;
     if (!(rg.norm() > 0.0)) break;
     Eigen::MatrixXd rh = b.transpose() * neg_hess * b;
@@ -611,16 +603,8 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable_in,
       mesh.vertices[v] = p0;
       return 0.0;
     }
-    Eigen::Matrix<double, 3, Eigen::Dynamic> basis(3, sliding[v] ? 2 : 3);
     const SurfacePoint& here = foot[v];
-    if (sliding[v]) {
-      Vec3 t1, t2;
-      tangent_frame(here.normal, t1, t2);
-      basis.col(0) = Eigen::Vector3d(t1[0], t1[1], t1[2]);
-      basis.col(1) = Eigen::Vector3d(t2[0], t2[1], t2[2]);
-    } else {
-      basis.setIdentity();
-    }
+    const Eigen::Matrix<double, 3, Eigen::Dynamic> basis = step_basis(sliding[v] ? &here : nullptr);
     const int dims = static_cast<int>(basis.cols());
     const Eigen::Vector3d g3(g0[0], g0[1], g0[2]);
     const Eigen::VectorXd gr = basis.transpose() * g3;

@@ -435,6 +435,18 @@ Vec3 bilinear(const QuadSurface& q, const std::array<int, 4>& quad, double u, do
   return p;
 }
 
+// The quads as triangles for distance queries: four per quad, fanned around its bilinear centre.
+TriSurface fan_triangles(const QuadSurface& quads) {
+  TriSurface t;
+  t.vertices = quads.vertices;
+  for (const auto& quad : quads.quads) {
+    const int centre = static_cast<int>(t.vertices.size());
+    t.vertices.push_back(bilinear(quads, quad, 0.5, 0.5));
+    for (int k = 0; k < 4; ++k) t.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
+  }
+  return t;
+}
+
 // The input surface with what placement needs: closest-point queries (plain and restricted) and, per
 // input vertex, its area share and normal for the Lloyd step.
 struct PlacementSurface {
@@ -685,14 +697,7 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
     return e;
   };
   for (int round = 0; round < rounds; ++round) {
-    TriSurface quad_triangles;
-    quad_triangles.vertices = fine.vertices;
-    for (const auto& quad : fine.quads) {
-      const int centre = static_cast<int>(quad_triangles.vertices.size());
-      quad_triangles.vertices.push_back(bilinear(fine, quad, 0.5, 0.5));
-      for (int k = 0; k < 4; ++k) quad_triangles.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
-    }
-    const SurfaceProjector quad_projector(quad_triangles);
+    const SurfaceProjector quad_projector(fan_triangles(fine));
     std::vector<std::vector<int>> charged(fine.quads.size());
     std::vector<std::pair<double, int>> far;
     for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
@@ -888,14 +893,7 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
           worst_quad = p;
         }
       }
-  TriSurface quad_triangles;
-  quad_triangles.vertices = fine.vertices;
-  for (const auto& quad : fine.quads) {
-    const int centre = static_cast<int>(quad_triangles.vertices.size());
-    quad_triangles.vertices.push_back(bilinear(fine, quad, 0.5, 0.5));
-    for (int k = 0; k < 4; ++k) quad_triangles.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
-  }
-  const SurfaceProjector quad_projector(quad_triangles);
+  const SurfaceProjector quad_projector(fan_triangles(fine));
   Vec3 worst_surface{0, 0, 0};
   for (const Vec3& v : surface.vertices) {
     const double d = quad_projector.distance(v);
