@@ -41,10 +41,12 @@ json level_figures(const Scenario& s, const LevelResult& l) {
   json probes = json::object();
   for (std::size_t i = 0; i < s.probes.size(); ++i) {
     const ProbeValue& p = u.probes[i];
-    probes[s.probes[i].name] = {{"at", vec(p.point)},
-                                {"found", p.found},
-                                {"displacement_mm", vec(p.displacement)},
-                                {"von_mises_MPa", p.von_mises}};
+    const Vec3& requested = s.probes[i].at.xyz;
+    const double moved =
+        std::hypot(p.point[0] - requested[0], p.point[1] - requested[1], p.point[2] - requested[2]);
+    probes[s.probes[i].name] = {
+        {"at", vec(p.point)}, {"requested_at", vec(requested)},         {"moved_mm", moved},
+        {"found", p.found},   {"displacement_mm", vec(p.displacement)}, {"von_mises_MPa", p.von_mises}};
   }
   return {{"level", l.level},
           {"hexes", l.mesh.hexes.size()},

@@ -202,6 +202,34 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
   return r;
 }
 
+// Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
+// nodes on the surface) runs up to a millimetre or two inside it, so such a point is often just outside the
+// mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
+// centre of the hex behind it, so that one hex contains it; results.json reports the requested point and
+// the distance moved.
+std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Probe>& probes) {
+  std::vector<Vec3> points;
+  if (probes.empty()) return points;
+  const HexBoundary boundary = extract_boundary(mesh);
+  const SurfaceProjector mesh_boundary(fan_triangles(boundary.surface));
+  for (const Probe& probe : probes) {
+    const Vec3& p = probe.at.xyz;
+    if (mesh_boundary.inside(p)) {
+      points.push_back(p);
+      continue;
+    }
+    const SurfacePoint foot = mesh_boundary.closest(p);
+    const auto& hex = mesh.hexes[boundary.quad_face[foot.triangle / 4][0]];
+    Vec3 centre{0, 0, 0};
+    for (int v : hex)
+      for (int a = 0; a < 3; ++a) centre[a] += mesh.vertices[v][a] / 8.0;
+    Vec3 moved;
+    for (int a = 0; a < 3; ++a) moved[a] = foot.point[a] + 0.01 * (centre[a] - foot.point[a]);
+    points.push_back(moved);
+  }
+  return points;
+}
+
 void solve_level(const Scenario& s, LevelResult& r) {
   ElasticityProblem p;
   p.mesh = &r.mesh;
@@ -221,7 +249,7 @@ void solve_level(const Scenario& s, LevelResult& r) {
     }
     p.supports.push_back(std::move(patch));
   }
-  for (const Probe& probe : s.probes) p.probes.push_back(probe.at.xyz);
+  p.probes = probe_points_in_mesh(r.mesh, s.probes);
   p.degree = s.solver.degree;
   const long long dofs = count_dofs(r.mesh, s.solver.degree);
   switch (s.solver.linear_solver) {

@@ -549,15 +549,7 @@ MeshFidelity measure_fidelity(const HexMesh& mesh, const SurfaceProjector& surfa
   const QuadSurface& q = boundary.surface;
 
   // The boundary as triangles, four per quad around its bilinear centre, for distances to the mesh.
-  TriSurface tri;
-  tri.vertices = q.vertices;
-  for (const auto& quad : q.quads) {
-    Vec3 c{0, 0, 0};
-    for (int v : quad) c = add(c, scale(q.vertices[v], 0.25));
-    const int ci = int(tri.vertices.size());
-    tri.vertices.push_back(c);
-    for (int e = 0; e < 4; ++e) tri.triangles.push_back({quad[e], quad[(e + 1) % 4], ci});
-  }
+  const TriSurface tri = fan_triangles(q);
   // Mesh to surface: boundary vertices, quad centres and edge midpoints.
   for (const Vec3& p : tri.vertices)
     f.hausdorff_mesh_to_surface = std::max(f.hausdorff_mesh_to_surface, surface.distance(p));

@@ -102,4 +102,18 @@ std::vector<char> boundary_vertex_mask(const HexMesh& mesh) {
   return mask;
 }
 
+TriSurface fan_triangles(const QuadSurface& quads) {
+  TriSurface t;
+  t.vertices = quads.vertices;
+  for (const auto& quad : quads.quads) {
+    const int centre = static_cast<int>(t.vertices.size());
+    Vec3 c{0, 0, 0};
+    for (int v : quad)
+      for (int a = 0; a < 3; ++a) c[a] += 0.25 * quads.vertices[v][a];
+    t.vertices.push_back(c);
+    for (int k = 0; k < 4; ++k) t.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
+  }
+  return t;
+}
+
 }  // namespace hexbite

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesher/hex_mesh.h"
+#include "mesher/tri_surface.h"
 
 namespace hexbite {
 
@@ -31,5 +32,10 @@ HexBoundary extract_boundary(const HexMesh& mesh);
 // mask[v] != 0 when vertex v lies on a face used by exactly one hex. Never throws: faces used by more than
 // two hexes are simply not boundary faces. Used by the quality summary to find the interior nodes.
 std::vector<char> boundary_vertex_mask(const HexMesh& mesh);
+
+// The quads as triangles for distance and inside queries: four per quad, fanned around its bilinear centre
+// (the mean of its corners, vertex quads.vertices.size() + q for quad q); triangles 4q..4q+3 come from quad
+// q.
+TriSurface fan_triangles(const QuadSurface& quads);
 
 }  // namespace hexbite

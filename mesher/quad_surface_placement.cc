@@ -9,6 +9,7 @@
 
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/hex_boundary.h"
 #include "mesher/mandible_quad_template.h"
 #include "mesher/quad_check.h"
 #include "mesher/surface_projector.h"
@@ -433,18 +434,6 @@ Vec3 bilinear(const QuadSurface& q, const std::array<int, 4>& quad, double u, do
   const double w[4] = {(1 - u) * (1 - v), u * (1 - v), u * v, (1 - u) * v};
   for (int k = 0; k < 4; ++k) p = add(p, scale(q.vertices[quad[k]], w[k]));
   return p;
-}
-
-// The quads as triangles for distance queries: four per quad, fanned around its bilinear centre.
-TriSurface fan_triangles(const QuadSurface& quads) {
-  TriSurface t;
-  t.vertices = quads.vertices;
-  for (const auto& quad : quads.quads) {
-    const int centre = static_cast<int>(t.vertices.size());
-    t.vertices.push_back(bilinear(quads, quad, 0.5, 0.5));
-    for (int k = 0; k < 4; ++k) t.triangles.push_back({quad[k], quad[(k + 1) % 4], centre});
-  }
-  return t;
 }
 
 // The input surface with what placement needs: closest-point queries (plain and restricted) and, per

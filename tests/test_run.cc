@@ -121,6 +121,24 @@ TEST_F(LateralBite, KeepsTheContractAndConvergesUnderRefinement) {
     EXPECT_LT(std::abs(r["validation"]["relative_change"][key].get<double>()), 0.10) << key;
 }
 
+// The shipped scenario's probes sit at landmarks on the bone surface, just outside the mesh's bilinear
+// boundary (before the probes were moved inside, all three came back with found: false and zeros).
+TEST_F(LateralBite, EvaluatesEveryProbeInsideTheMesh) {
+  const json& levels = (*results_)["validation"]["levels"];
+  ASSERT_EQ(levels.size(), 2u);
+  for (const json& level : levels) {
+    ASSERT_EQ(level["probes"].size(), 3u);
+    for (const auto& [name, probe] : level["probes"].items()) {
+      SCOPED_TRACE(name + " at level " + std::to_string(level["level"].get<int>()));
+      EXPECT_TRUE(probe["found"].get<bool>());
+      EXPECT_LT(probe["moved_mm"].get<double>(), 3.0);
+      const std::vector<double> u = probe["displacement_mm"].get<std::vector<double>>();
+      EXPECT_GT(std::hypot(u[0], u[1], u[2]), 1e-4);
+      EXPECT_GT(probe["von_mises_MPa"].get<double>(), 0.0);
+    }
+  }
+}
+
 TEST_F(LateralBite, WritesMeshAndSolutionFilesMatchingTheResults) {
   const json& r = *results_;
   std::vector<MeshArray> cells, points;
