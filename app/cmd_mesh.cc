@@ -138,25 +138,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
                   {"optimize", r.seconds_optimize},
                   {"fidelity", r.seconds_fidelity},
                   {"total", r.seconds_total}};
-  const MeshFidelity& f = r.fidelity;
-  nlohmann::json unresolved = nlohmann::json::array();
-  for (const UnresolvedPart& u : f.unresolved) {
-    nlohmann::json near = nlohmann::json::array();
-    for (const NearbyPoint& n : u.near) near.push_back({{"name", n.name}, {"distance_mm", n.distance}});
-    unresolved.push_back({{"location", u.location},
-                          {"extent_mm", u.extent},
-                          {"samples", u.samples},
-                          {"near", near},
-                          {"what", u.what}});
-  }
-  j["fidelity"] = {{"hausdorff_mm", f.hausdorff},
-                   {"hausdorff_mesh_to_surface_mm", f.hausdorff_mesh_to_surface},
-                   {"hausdorff_surface_to_mesh_mm", f.hausdorff_surface_to_mesh},
-                   {"mean_edge_length_mm", f.mean_edge_length},
-                   {"mesh_volume_mm3", f.mesh_volume},
-                   {"surface_volume_mm3", f.surface_volume},
-                   {"volume_difference", f.volume_difference},
-                   {"unresolved", unresolved}};
+  j["fidelity"] = fidelity_to_json(r.fidelity);
   j["inverted"] = r.optimize.inverted;
   j["output"] = written ? nlohmann::json(o.output) : nlohmann::json();
   return j;

@@ -294,19 +294,12 @@ json results_json(const RunResult& r, double seconds_output) {
   j["scenario"] = s.name;
   j["scenario_file"] = s.path;
   j["mesh_method"] = s.mesh.method == MeshMethod::kSheets ? "sheets" : "grid";
-  const MeshFidelity& f = r.fidelity;
   j["mesh"] = {{"hexes", coarse.mesh.hexes.size()},
                {"nodes", coarse.mesh.vertices.size()},
                {"dofs", coarse.solution.dofs},
                {"degree", s.solver.degree},
                {"quality", quality_to_json(coarse.quality)},
-               {"fidelity",
-                {{"hausdorff_mm", f.hausdorff},
-                 {"hausdorff_mesh_to_surface_mm", f.hausdorff_mesh_to_surface},
-                 {"hausdorff_surface_to_mesh_mm", f.hausdorff_surface_to_mesh},
-                 {"mesh_volume_mm3", f.mesh_volume},
-                 {"surface_volume_mm3", f.surface_volume},
-                 {"volume_difference", f.volume_difference}}}};
+               {"fidelity", fidelity_to_json(r.fidelity)}};
   json muscles = json::array();
   for (std::size_t i = 0; i < coarse.muscle_patches.size(); ++i)
     muscles.push_back({{"name", coarse.muscle_patches[i].name},

@@ -65,7 +65,9 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   options.target_hexes = s.mesh.target_hexes;
   GridMeshReport report;
   HexMesh mesh = grid_mesh(geometry.surface, options, &report);
+  name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
+  for (const UnresolvedPart& part : report.fidelity.unresolved) info("not resolved: " + part.what);
   if (report.optimize.inverted > 0)
     throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +

@@ -55,4 +55,25 @@ nlohmann::json quality_to_json(const QualitySummary& summary, double volume_mm3)
   return j;
 }
 
+nlohmann::json fidelity_to_json(const MeshFidelity& f) {
+  nlohmann::json unresolved = nlohmann::json::array();
+  for (const UnresolvedPart& u : f.unresolved) {
+    nlohmann::json near = nlohmann::json::array();
+    for (const NearbyPoint& n : u.near) near.push_back({{"name", n.name}, {"distance_mm", n.distance}});
+    unresolved.push_back({{"location", u.location},
+                          {"extent_mm", u.extent},
+                          {"samples", u.samples},
+                          {"near", near},
+                          {"what", u.what}});
+  }
+  return {{"hausdorff_mm", f.hausdorff},
+          {"hausdorff_mesh_to_surface_mm", f.hausdorff_mesh_to_surface},
+          {"hausdorff_surface_to_mesh_mm", f.hausdorff_surface_to_mesh},
+          {"mean_edge_length_mm", f.mean_edge_length},
+          {"mesh_volume_mm3", f.mesh_volume},
+          {"surface_volume_mm3", f.surface_volume},
+          {"volume_difference", f.volume_difference},
+          {"unresolved", unresolved}};
+}
+
 }  // namespace hexbite

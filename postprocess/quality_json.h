@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesher/grid_mesher.h"
 #include "mesher/hex_quality.h"
 
 namespace hexbite {
@@ -19,5 +20,11 @@ nlohmann::json quality_to_json(const QualitySummary& summary);
 // The same object plus `volume_mm3`, the mesh volume (hex_mesh_volume: exact for trilinear hexes, inverted
 // parts counted negative), as `hexbite quality --json` prints it. results.json keeps the object above.
 nlohmann::json quality_to_json(const QualitySummary& summary, double volume_mm3);
+
+// A mesh's geometric fidelity, as `hexbite mesh --json` prints it and results.json embeds it: hausdorff_mm,
+// hausdorff_mesh_to_surface_mm, hausdorff_surface_to_mesh_mm, mean_edge_length_mm, mesh_volume_mm3,
+// surface_volume_mm3, volume_difference, and unresolved: [{location, extent_mm, samples, near [{name,
+// distance_mm}], what}].
+nlohmann::json fidelity_to_json(const MeshFidelity& fidelity);
 
 }  // namespace hexbite

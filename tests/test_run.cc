@@ -139,6 +139,21 @@ TEST_F(LateralBite, EvaluatesEveryProbeInsideTheMesh) {
   }
 }
 
+// At 4,000 hexes the coronoid tips are thinner than a cell; results.json names them by the built-in
+// mandible's landmarks, as `hexbite mesh --landmarks` does.
+TEST_F(LateralBite, NamesThePartsTheMeshDoesNotResolve) {
+  const json& unresolved = (*results_)["mesh"]["fidelity"]["unresolved"];
+  ASSERT_FALSE(unresolved.empty());
+  bool coronoid = false;
+  for (const json& part : unresolved) {
+    ASSERT_FALSE(part["near"].empty()) << part.dump();
+    for (const json& n : part["near"])
+      coronoid |= n["name"].get<std::string>().find("coronoid_tip") != std::string::npos;
+    EXPECT_GT(part["extent_mm"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(coronoid) << unresolved.dump();
+}
+
 TEST_F(LateralBite, WritesMeshAndSolutionFilesMatchingTheResults) {
   const json& r = *results_;
   std::vector<MeshArray> cells, points;
