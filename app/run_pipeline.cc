@@ -194,11 +194,8 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
     r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm, sup.where,
                                              "support '" + sup.name + "'"));
   r.hex_material.reserve(r.mesh.hexes.size());
-  for (const auto& hex : r.mesh.hexes) {
-    Vec3 c{0, 0, 0};
-    for (int v : hex)
-      for (int d = 0; d < 3; ++d) c[d] += r.mesh.vertices[v][d] / 8.0;
-    const MaterialSpec m = material_at(s.materials, c);
+  for (std::size_t h = 0; h < r.mesh.hexes.size(); ++h) {
+    const MaterialSpec m = material_at(s.materials, hex_centroid(r.mesh, static_cast<int>(h)));
     r.hex_material.push_back({m.E_MPa, m.poisson});
   }
   return r;
@@ -221,10 +218,7 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Pr
       continue;
     }
     const SurfacePoint foot = mesh_boundary.closest(p);
-    const auto& hex = mesh.hexes[boundary.quad_face[foot.triangle / 4][0]];
-    Vec3 centre{0, 0, 0};
-    for (int v : hex)
-      for (int a = 0; a < 3; ++a) centre[a] += mesh.vertices[v][a] / 8.0;
+    const Vec3 centre = hex_centroid(mesh, boundary.quad_face[foot.triangle / 4][0]);
     Vec3 moved;
     for (int a = 0; a < 3; ++a) moved[a] = foot.point[a] + 0.01 * (centre[a] - foot.point[a]);
     points.push_back(moved);

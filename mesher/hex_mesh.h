@@ -16,6 +16,14 @@ struct HexMesh {
   std::vector<std::array<int, 8>> hexes;
 };
 
+// The mean of hex h's eight vertices.
+inline Vec3 hex_centroid(const HexMesh& mesh, int h) {
+  Vec3 c{0.0, 0.0, 0.0};
+  for (int v : mesh.hexes[h])
+    for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
+  return c;
+}
+
 // A quad surface: quads counter-clockwise seen from outside.
 struct QuadSurface {
   std::vector<Vec3> vertices;

@@ -156,9 +156,7 @@ std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes, st
   shown = std::min(shown, hexes.size());
   for (std::size_t i = 0; i < shown; ++i) {
     const int h = hexes[i];
-    Vec3 c{0, 0, 0};
-    for (int v : mesh.hexes[h])
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
+    const Vec3 c = hex_centroid(mesh, h);
     char buf[128];
     std::snprintf(buf, sizeof buf, " at (%.2f, %.2f, %.2f) mm", c[0], c[1], c[2]);
     out << (i ? ", " : "") << "hex " << h << (label ? label(h) : std::string()) << buf;

@@ -13,14 +13,6 @@ namespace hexbite {
 
 namespace {
 
-Vec3 centroid(const HexMesh& mesh, int h) {
-  Vec3 c{0.0, 0.0, 0.0};
-  for (int v : mesh.hexes[h])
-    for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a];
-  for (int a = 0; a < 3; ++a) c[a] /= 8.0;
-  return c;
-}
-
 // Ascending old indices of the hexes that have a boundary face.
 std::vector<int> boundary_hexes(const HexMesh& mesh) {
   std::vector<int> hexes;
@@ -107,7 +99,7 @@ int nearest_boundary_hex(const HexMesh& mesh, const Vec3& point) {
   int best = -1;
   double best_d2 = std::numeric_limits<double>::infinity();
   for (int h : boundary_hexes(mesh)) {
-    const Vec3 c = centroid(mesh, h);
+    const Vec3 c = hex_centroid(mesh, h);
     const double d2 = (c[0] - point[0]) * (c[0] - point[0]) + (c[1] - point[1]) * (c[1] - point[1]) +
                       (c[2] - point[2]) * (c[2] - point[2]);
     if (d2 < best_d2) {
@@ -122,7 +114,7 @@ int smallest_x_boundary_hex(const HexMesh& mesh) {
   int best = -1;
   double best_x = std::numeric_limits<double>::infinity();
   for (int h : boundary_hexes(mesh)) {
-    const double x = centroid(mesh, h)[0];
+    const double x = hex_centroid(mesh, h)[0];
     if (x < best_x) {
       best_x = x;
       best = h;

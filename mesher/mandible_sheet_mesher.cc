@@ -20,11 +20,9 @@ void pillow(HexMesh& mesh, const QuadSurface& quads) {
   const int n = static_cast<int>(quads.vertices.size());
   std::vector<Vec3> inward(n, Vec3{0, 0, 0});
   std::vector<int> count(n, 0);
-  for (const auto& hex : mesh.hexes) {
-    Vec3 c{0, 0, 0};
-    for (int v : hex)
-      for (int a = 0; a < 3; ++a) c[a] += mesh.vertices[v][a] / 8.0;
-    for (int v : hex)
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    const Vec3 c = hex_centroid(mesh, static_cast<int>(h));
+    for (int v : mesh.hexes[h])
       if (v < n) {
         for (int a = 0; a < 3; ++a) inward[v][a] += c[a];
         ++count[v];

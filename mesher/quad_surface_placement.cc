@@ -59,7 +59,9 @@ Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
 
 // Closest surface point among the triangles whose outward normal agrees with a given direction: the
 // multi-patch restriction that keeps a node on its own side of a thin plate. A uniform grid of triangle
-// bounding boxes, searched in growing rings until no closer triangle can remain.
+// bounding boxes, searched in growing rings until no closer triangle can remain. Hand-written, with the
+// closest-point routine above: SurfaceProjector's CGAL AABB tree answers closest-point queries over all
+// triangles only, and a filtered search would need custom traversal traits on it.
 class OrientedProjector {
  public:
   explicit OrientedProjector(const TriSurface& s) : s_(s) {
