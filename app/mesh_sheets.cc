@@ -31,6 +31,9 @@ std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
       << " eliminations (" << r.eliminations_single << " single, " << r.eliminations_k_step << " k-step; "
       << r.external_sheets << " external, " << r.internal_sheets << " internal sheets), " << r.decompositions
       << " decompositions, " << r.hexes << " hexes, " << r.interior_vertices << " interior nodes\n";
+  if (r.pillow_hexes > 0)
+    out << "pillow layer under the boundary: " << r.pillow_hexes << " hexes added, as "
+        << r.inverted_without_pillow << " hexes stayed inverted without it\n";
   out << sheet_quality_text(r.quality);
   std::snprintf(line, sizeof line, "time: elimination %.2f s, embedding %.2f s\n", r.seconds_elimination,
                 r.seconds_embedding);
@@ -65,6 +68,8 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
     j["method"] = "sheets";
     j["order"] = elimination_order_name(order);
     add_sheet_report_json(report, j);
+    j["pillow_hexes"] = report.pillow_hexes;
+    j["inverted_without_pillow"] = report.inverted_without_pillow;
     j["seconds"] = {{"elimination", report.seconds_elimination}, {"embedding", report.seconds_embedding}};
     j["output"] = write ? nlohmann::json(o.output) : nlohmann::json();
     std::cout << j.dump(2) << '\n';

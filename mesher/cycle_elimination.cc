@@ -7,6 +7,7 @@
 
 #include "common/error.h"
 #include "mesher/elimination_feasibility.h"
+#include "mesher/hex_pillow.h"
 #include "mesher/internal_sheet.h"
 #include "mesher/quad_check.h"
 #include "mesher/vec3.h"
@@ -688,6 +689,21 @@ HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOpt
   const auto t1 = Clock::now();
   const int n = static_cast<int>(surface.vertices.size());
   OptimizeReport opt = embed(mesh, n, options);
+  QualitySummary quality = summarize_quality(mesh);
+  const int inverted_without_pillow = quality.inverted;
+  int pillow_hexes = 0;
+  if (options.optimize && options.pillow_if_inverted && quality.inverted > 0) {
+    HexMesh pillowed = mesh;
+    const int added = pillow_quad_boundary(pillowed, surface, 0.4);
+    OptimizeReport pillowed_opt = embed(pillowed, n, options);
+    QualitySummary pillowed_quality = summarize_quality(pillowed);
+    if (pillowed_quality.inverted < quality.inverted) {
+      mesh = std::move(pillowed);
+      opt = std::move(pillowed_opt);
+      quality = std::move(pillowed_quality);
+      pillow_hexes = added;
+    }
+  }
   const auto t2 = Clock::now();
   if (report) {
     SheetMeshReport& r = *report;
@@ -701,7 +717,9 @@ HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOpt
     r.seconds_elimination = std::chrono::duration<double>(t1 - t0).count();
     r.seconds_embedding = std::chrono::duration<double>(t2 - t1).count();
     r.optimize = std::move(opt);
-    r.quality = summarize_quality(mesh);
+    r.quality = std::move(quality);
+    r.pillow_hexes = pillow_hexes;
+    r.inverted_without_pillow = inverted_without_pillow;
   }
   return mesh;
 }

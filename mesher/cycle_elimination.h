@@ -25,6 +25,10 @@
 //   (ids >= n) are new.
 //   3. Embedding: new vertices start at the position of the vertex they were split from, then barycentric
 //      smoothing to convergence and optimize_hex_mesh() with every boundary vertex fixed.
+//   4. Pillow rescue: where hexes stay inverted (typically hexes with two faces on the boundary at a flat
+//      angle, or a complex without interior vertices), a pillow layer under the boundary (mesher/
+//      hex_pillow.h) and step 3 again; the result with fewer inverted hexes is kept. The boundary is
+//      still exactly the input.
 // Ordering strategies (single eliminations first try the smallest side; ties: the lower chord number):
 //   kFewestHexes takes the first feasible single elimination; kLookAhead the first after which the surface
 //   is a cube or still has a feasible single elimination (no dead end one step on); kGeometric, the seed's
@@ -129,6 +133,9 @@ struct SheetMeshOptions {
   int smoothing_iterations = 500;  // barycentric sweeps before the optimizer
   bool optimize = true;
   OptimizeOptions optimizer;
+  // When hexes stay inverted after the embedding (only with optimize): add a pillow layer under the
+  // boundary (mesher/hex_pillow.h), embed again, and keep the result with fewer inverted hexes.
+  bool pillow_if_inverted = true;
 };
 
 struct SheetMeshReport {
@@ -148,6 +155,10 @@ struct SheetMeshReport {
   double seconds_embedding = 0.0;
   OptimizeReport optimize;  // empty phases when optimization is off
   QualitySummary quality;   // of the final mesh (node degrees inside)
+  // The pillow rescue (SheetMeshOptions::pillow_if_inverted): hexes it added to the final mesh (0 when it
+  // did not run or did not help) and the inverted hexes of the embedding without it.
+  int pillow_hexes = 0;
+  int inverted_without_pillow = 0;
 };
 
 // Steps 1 to 3, with decomposition where the elimination is stuck. The counts of eliminations and sheets

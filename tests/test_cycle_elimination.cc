@@ -201,16 +201,45 @@ TEST(CycleElimination, GeometricOrderTakesTheAnnularSheetOfAnOGridDisk) {
   EXPECT_EQ(geometric.eliminations_single, 2);
   EXPECT_EQ(geometric.hexes, 12);
   EXPECT_EQ(geometric.interior_vertices, 0);
+  EXPECT_EQ(geometric.pillow_hexes, 0);
   // Fewest-hexes (single eliminations only) first puts 4 hexes on a cap's 2 x 2 centre, whose rail then
   // merges into the rim in the same plane; with every vertex on the boundary nothing can repair that.
   SheetMeshOptions fewest_hexes;
   fewest_hexes.elimination.order = EliminationOrder::kFewestHexes;
+  fewest_hexes.pillow_if_inverted = false;
   SheetMeshReport fewest;
   mesh_by_cycle_elimination(s, fewest_hexes, &fewest);
   EXPECT_EQ(fewest.eliminations_k_step, 0);
   EXPECT_EQ(fewest.eliminations_single, 4);
-  EXPECT_GT(fewest.quality.inverted, 0);
+  EXPECT_EQ(fewest.quality.inverted, 8);
   EXPECT_GT(geometric.quality.scaled_jacobian.min, fewest.quality.scaled_jacobian.min);
+  // The pillow rescue gives those hexes interior vertices: valid, one hex per boundary quad more.
+  const SheetMeshReport rescued = expect_valid_sheet_mesh(s, EliminationOrder::kFewestHexes);
+  EXPECT_EQ(rescued.inverted_without_pillow, 8);
+  EXPECT_EQ(rescued.pillow_hexes, static_cast<int>(s.quads.size()));
+  EXPECT_EQ(rescued.hexes, 12 + rescued.pillow_hexes);
+}
+
+// A cubed sphere with every vertex moved by up to 0.3 of the radius 10 (8 x 8 per face, 384 quads): the
+// elimination's hexes keep 47 inverted whatever the interior does, mostly corner hexes with two faces on
+// the boundary at a flat angle. The pillow rescue puts one layer under the boundary (384 hexes), after
+// which the embedding is valid; the boundary is still exactly the input.
+TEST(CycleElimination, PillowRescuesAPerturbedSphere) {
+  const QuadSurface s = test::perturbed(test::sphere_surface(8, 10.0), 0.3);
+  ASSERT_TRUE(check_quad_surface(s, "").usable());
+  SheetMeshOptions plain;
+  plain.pillow_if_inverted = false;
+  SheetMeshReport without;
+  mesh_by_cycle_elimination(s, plain, &without);
+  EXPECT_EQ(without.hexes, 512);
+  EXPECT_EQ(without.quality.inverted, 47);
+  EXPECT_EQ(without.pillow_hexes, 0);
+  const SheetMeshReport with = expect_valid_sheet_mesh(s, EliminationOrder::kGeometric);
+  EXPECT_EQ(with.inverted_without_pillow, 47);
+  EXPECT_EQ(with.pillow_hexes, 384);
+  EXPECT_EQ(with.hexes, 512 + 384);
+  EXPECT_GT(with.quality.scaled_jacobian.min, 0.4);
+  EXPECT_GT(with.quality.scaled_jacobian.mean, 0.85);
 }
 
 // The pillowed block's ring chord has the shrunk quad as its smaller side, in the plane of the top face:
@@ -236,12 +265,22 @@ TEST(CycleElimination, InternalSheetUnderAPillowedPatch) {
   SheetMeshOptions external_only;
   external_only.elimination.order = EliminationOrder::kFewestHexes;
   external_only.internal_sheets = false;
+  external_only.pillow_if_inverted = false;
   SheetMeshReport external;
   const HexMesh mesh = mesh_by_cycle_elimination(s, external_only, &external);
   expect_boundary_equals_input(mesh, s);
   EXPECT_EQ(external.internal_sheets, 0);
   EXPECT_EQ(external.hexes, 28);
   EXPECT_EQ(external.quality.inverted, 1);
+  // With the pillow rescue the flat hex gets interior vertices and the external mesh is valid too, at the
+  // price of 58 pillow hexes instead of the internal sheet's 4 more.
+  external_only.pillow_if_inverted = true;
+  const HexMesh rescued = mesh_by_cycle_elimination(s, external_only, &external);
+  expect_boundary_equals_input(rescued, s);
+  EXPECT_EQ(external.inverted_without_pillow, 1);
+  EXPECT_EQ(external.pillow_hexes, 58);
+  EXPECT_EQ(external.hexes, 28 + 58);
+  EXPECT_EQ(external.quality.inverted, 0);
 
   // The two-argument construction is the external one; the overload reports the kinds in elimination
   // order (the ring, eliminated first, got the internal sheet).
@@ -334,11 +373,15 @@ TEST(CycleElimination, DecompositionSplitsABlockAtAnEquatorWithAFan) {
 // 8-cycle with 15 quads on either side, spanned by a ladder of 3 quads, leaves two 18-quad parts that
 // eliminate (4 single eliminations in all). The result must be conforming (extract_boundary() throws
 // otherwise), bounded by exactly the input, and every hex must have 8 distinct vertices. The 10 hexes have
-// no interior vertex, so the embedding cannot move anything: 6 are inverted on both geometries (the
-// collapsed quads of no_scheme_surface() have three collinear corners, the convex version keeps 6 too),
-// which the command reports and refuses to write without --allow-invalid.
+// no interior vertex, so the embedding cannot move anything: 6 are inverted on both geometries. The pillow
+// rescue gives them interior vertices: on the convex version 2 stay inverted (40 hexes); on
+// no_scheme_surface(), whose collapsed quads have three collinear corners (a corner Jacobian of 0 on the
+// boundary whatever the interior), it does not help and the 10 hexes are kept. The command reports the
+// inverted hexes and refuses to write without --allow-invalid.
 TEST(CycleElimination, StuckSurfaceMeshesByDecomposition) {
-  for (const QuadSurface& s : {test::no_scheme_surface(), test::no_scheme_convex_surface()}) {
+  const std::array<QuadSurface, 2> surfaces{test::no_scheme_surface(), test::no_scheme_convex_surface()};
+  for (int convex = 0; convex < 2; ++convex) {
+    const QuadSurface& s = surfaces[convex];
     for (EliminationOrder order :
          {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
       SCOPED_TRACE(elimination_order_name(order));
@@ -347,20 +390,23 @@ TEST(CycleElimination, StuckSurfaceMeshesByDecomposition) {
       SheetMeshReport r;
       const HexMesh mesh = mesh_by_cycle_elimination(s, options, &r);
       expect_boundary_equals_input(mesh, s);
-      ASSERT_EQ(mesh.hexes.size(), 10u);
+      const int pillow = convex ? 30 : 0;
+      ASSERT_EQ(mesh.hexes.size(), 10u + pillow);
       for (const auto& hex : mesh.hexes) {
         auto sorted = hex;
         std::sort(sorted.begin(), sorted.end());
         EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
       }
       EXPECT_EQ(r.decompositions, 1);
-      EXPECT_EQ(r.hexes, 10);
-      EXPECT_EQ(r.interior_vertices, 0);
+      EXPECT_EQ(r.hexes, 10 + pillow);
+      EXPECT_EQ(r.pillow_hexes, pillow);
+      EXPECT_EQ(r.interior_vertices, convex ? 32 : 0);  // a copy of every boundary vertex
       EXPECT_EQ(r.eliminations, 4);
       EXPECT_EQ(r.eliminations_single, 4);
       EXPECT_EQ(r.chords_eliminated, 4);
       EXPECT_EQ(r.external_sheets + r.internal_sheets, 4);
-      EXPECT_EQ(r.quality.inverted, 6);
+      EXPECT_EQ(r.inverted_without_pillow, 6);
+      EXPECT_EQ(r.quality.inverted, convex ? 2 : 6);
     }
   }
   // A surface with a scheme is never decomposed.
