@@ -1,6 +1,7 @@
 // hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--landmarks L.yaml]
 // [--json] [--allow-invalid]
-// hexbite mesh SURFACE --method sheets [--landmarks L.yaml] --target-hexes N -o mesh.vtu (a mandible:
+// hexbite mesh SURFACE --method sheets [--landmarks L.yaml] --target-hexes N -o mesh.vtu [--refine-at
+// X,Y,Z|LANDMARK [--refine-radius MM] [--refine-levels K]] (a mandible:
 // app/mesh_sheets_surface.h) or hexbite mesh --method sheets --quad-surface Q.obj -o mesh.vtu
 // (app/mesh_sheets.h)
 //
@@ -48,6 +49,7 @@ struct MeshOptions {
   std::string quad_surface;         // --method sheets
   std::string order = "geometric";  // --method sheets
   std::string landmarks;            // --method sheets on a SURFACE; names unresolved parts for grid
+  RefineCommandOptions refine;      // --method sheets on a SURFACE
 };
 
 std::string fmt(const char* format, double v) {
@@ -146,8 +148,15 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
 
 void run_mesh(const MeshOptions& o) {
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
-    return run_mesh_sheets_surface(
-        {{o.surface, o.landmarks, o.units, 0, o.output, o.json}, o.target, o.order, o.allow_invalid});
+    return run_mesh_sheets_surface({{o.surface, o.landmarks, o.units, 0, o.output, o.json, o.refine},
+                                    o.target,
+                                    o.order,
+                                    o.allow_invalid});
+  if (!o.refine.at.empty())
+    throw InputError(
+        "--refine-at refines the quad surface that --method sheets places on a mandible SURFACE; "
+        "it does nothing for --method grid or --quad-surface: drop it, or run --method sheets on "
+        "the SURFACE");
   if (o.method == "sheets")
     return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
@@ -221,6 +230,7 @@ void add_mesh_command(CLI::App& app) {
       ->default_val(o->margin);
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");
+  add_refine_options(*cmd, o->refine);
   cmd->callback([o] { run_mesh(*o); });
 }
 

@@ -1,5 +1,6 @@
 // hexbite quad check Q.obj [--json]
 // hexbite quad from-mandible SURFACE [--landmarks L.yaml] [--target-quads N] -o Q.obj [--json]
+//   [--refine-at X,Y,Z|LANDMARK [--refine-radius MM] [--refine-levels K]]
 //
 // Reports what the sheet mesher (hexbite mesh --method sheets) needs to know about a quad surface: closed,
 // manifold, genus, even quad count, simple, planar and 3-connected graph, the chords with their lengths and
@@ -161,6 +162,7 @@ void add_quad_commands(CLI::App& app) {
       ->default_val("mm");
   fm->add_option("-o,--output", from->output, "Output quad surface (.obj)")->required();
   fm->add_flag("--json", from->json, "Print the report as one JSON object on standard output");
+  add_refine_options(*fm, from->refine);
   fm->callback([from] { run_quad_from_mandible(*from); });
 }
 

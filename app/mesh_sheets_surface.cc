@@ -1,5 +1,6 @@
 #include "app/mesh_sheets_surface.h"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -87,19 +88,103 @@ std::string quad_text(const std::string& surface, const MandibleQuadReport& r,
   return out.str();
 }
 
+// The refinement point of --refine-at: "X,Y,Z" in mm, or the name of a point of the landmark file.
+LocalRefinementOptions refinement_options(const RefineCommandOptions& r, const Landmarks* landmarks,
+                                          const std::string& landmark_file) {
+  LocalRefinementOptions options;
+  if (r.at.empty()) return options;
+  options.radius_mm = r.radius_mm;
+  options.levels = r.levels;
+  options.point_names = {"--refine-at " + r.at};
+  Vec3 p{};
+  char rest = 0;
+  if (std::sscanf(r.at.c_str(), "%lf,%lf,%lf%c", &p[0], &p[1], &p[2], &rest) == 3) {
+    options.points = {p};
+    return options;
+  }
+  if (!landmarks)
+    throw InputError("--refine-at '" + r.at +
+                     "' is not X,Y,Z and no --landmarks file was given to look it up in: give the point as "
+                     "X,Y,Z in mm (e.g. --refine-at -27.9,-16.8,49.3) or add --landmarks L.yaml");
+  const std::optional<Vec3> named = landmarks->find(r.at);
+  if (!named) {
+    std::string names;
+    for (const auto& [name, q] : landmarks->points) names += (names.empty() ? "" : ", ") + name;
+    throw InputError("--refine-at '" + r.at + "' is not a point of the landmark file '" + landmark_file +
+                     "': give one of its landmarks (" + names + "), a '<muscle>.insertion', or X,Y,Z in mm");
+  }
+  options.points = {*named};
+  return options;
+}
+
+nlohmann::json refinement_json(const RefineCommandOptions& r, const LocalRefinementReport& report) {
+  if (report.sites.empty()) return nullptr;
+  const LocalRefinementSite& site = report.sites.front();
+  return {{"at", r.at},
+          {"point", site.point},
+          {"on_surface", site.on_surface},
+          {"radius_mm", r.radius_mm},
+          {"levels", report.levels},
+          {"patch_quads", report.patch_quads},
+          {"patch_perimeter", report.patch_perimeter},
+          {"quads_added", report.quads_added},
+          {"vertices_added", report.vertices_added},
+          {"moved_vertices", report.moved_vertices},
+          {"relax_sweeps", report.relax_sweeps},
+          {"folded_quads", report.folded_quads},
+          {"edges_near_before", site.edges_before},
+          {"edges_near_after", site.edges_after},
+          {"mean_edge_near_before_mm", site.mean_edge_before_mm},
+          {"mean_edge_near_after_mm", site.mean_edge_after_mm},
+          {"seconds", report.seconds}};
+}
+
+std::string refinement_text(const RefineCommandOptions& r, const LocalRefinementReport& report) {
+  if (report.sites.empty()) return "";
+  const LocalRefinementSite& site = report.sites.front();
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "Local refinement at %s (%.1f, %.1f, %.1f) mm: %d rings of %d quads around a patch of %d "
+                "quads (+%d quads); mean edge within %.1f mm %.2f -> %.2f mm (%d -> %d edges); %d folded "
+                "quads; %.2f s\n",
+                r.at.c_str(), site.on_surface[0], site.on_surface[1], site.on_surface[2], report.levels,
+                report.patch_perimeter, report.patch_quads, report.quads_added, r.radius_mm,
+                site.mean_edge_before_mm, site.mean_edge_after_mm, site.edges_before, site.edges_after,
+                report.folded_quads, report.seconds);
+  return line;
+}
+
 }  // namespace
+
+void add_refine_options(CLI::App& cmd, RefineCommandOptions& o) {
+  CLI::Option* at = cmd.add_option(
+      "--refine-at", o.at,
+      "Refine the quad surface locally around this point (the bite point): X,Y,Z in mm, or a name in the "
+      "--landmarks file such as right_first_molar_bite_point");
+  cmd.add_option("--refine-radius", o.radius_mm, "Radius of the refined patch around --refine-at, in mm")
+      ->check(CLI::Range(kMinRefineRadiusMm, kMaxRefineRadiusMm))
+      ->capture_default_str()
+      ->needs(at);
+  cmd.add_option("--refine-levels", o.levels,
+                 "Rings of quads added around the patch; each makes the quads inside it smaller")
+      ->check(CLI::Range(1, kMaxRefineLevels))
+      ->capture_default_str()
+      ->needs(at);
+}
 
 void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
   const double scale = unit_to_mm(o.units);
   const TriSurface surface = load_closed_surface(o.surface, scale);
   std::unique_ptr<Landmarks> landmarks;
   if (!o.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(o.landmarks, scale));
+  const LocalRefinementOptions refinement = refinement_options(o.refine, landmarks.get(), o.landmarks);
   MandibleQuadReport report;
   QuadSurfaceReport check;
+  LocalRefinementReport refinement_report;
   QuadSurface quads;
   try {
     quads = checked_mandible_quads(surface, landmarks.get(), o.target_quads, o.surface, o.landmarks, &report,
-                                   &check);
+                                   &check, refinement, &refinement_report);
   } catch (const RunError& e) {
     throw RunError(std::string(e.what()) + "; use --method grid for this surface");
   }
@@ -109,10 +194,11 @@ void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
     j["surface"] = o.surface;
     j["landmarks"] = o.landmarks.empty() ? nlohmann::json() : nlohmann::json(o.landmarks);
     j["target_quads"] = o.target_quads;
+    j["local_refinement"] = refinement_json(o.refine, refinement_report);
     j["output"] = o.output;
     std::cout << j.dump(2) << '\n';
   } else if (!is_quiet()) {
-    std::cout << quad_text(o.surface, report, check);
+    std::cout << quad_text(o.surface, report, check) << refinement_text(o.refine, refinement_report);
     info("wrote " + o.output);
   }
 }
@@ -132,6 +218,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   const TriSurface surface = load_closed_surface(qo.surface, scale);
   std::unique_ptr<Landmarks> landmarks;
   if (!qo.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(qo.landmarks, scale));
+  options.refinement = refinement_options(qo.refine, landmarks.get(), qo.landmarks);
   MandibleSheetReport sheet_report;
   HexMesh mesh;
   try {
@@ -157,6 +244,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     j["order"] = elimination_order_name(order);
     j["target_hexes"] = o.target_hexes;
     j["quad_surface"] = quad_json(quad_report, check);
+    j["local_refinement"] = refinement_json(qo.refine, sheet_report.refinement);
     add_sheet_report_json(report, j);
     j["pillow_hexes"] = sheet_report.pillow_hexes;
     j["seconds"] = {{"quad_surface", quad_report.seconds},
@@ -171,7 +259,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     std::cout << j.dump(2) << '\n';
   } else if (!is_quiet()) {
     std::ostringstream out;
-    out << quad_text(qo.surface, quad_report, check);
+    out << quad_text(qo.surface, quad_report, check) << refinement_text(qo.refine, sheet_report.refinement);
     char line[512];
     std::snprintf(
         line, sizeof line,

@@ -7,7 +7,25 @@
 
 #include <string>
 
+#include "mesher/landmarks.h"
+#include "mesher/quad_local_refinement.h"
+
+namespace CLI {
+class App;
+}
+
 namespace hexbite {
+
+// --refine-at X,Y,Z|LANDMARK [--refine-radius MM] [--refine-levels K]: local refinement of the quad surface
+// around one point (mesher/quad_local_refinement.h); `at` empty: none.
+struct RefineCommandOptions {
+  std::string at;
+  double radius_mm = LocalRefinementOptions{}.radius_mm;
+  int levels = LocalRefinementOptions{}.levels;
+};
+
+// Adds the three options to `cmd` (quad from-mandible, mesh).
+void add_refine_options(CLI::App& cmd, RefineCommandOptions& options);
 
 struct MandibleQuadCommandOptions {
   std::string surface;    // closed triangle surface of a mandible
@@ -16,6 +34,7 @@ struct MandibleQuadCommandOptions {
   int target_quads = 1300;
   std::string output;  // .obj (quad from-mandible) or .vtu (mesh)
   bool json = false;
+  RefineCommandOptions refine;
 };
 
 // quad from-mandible: builds, checks (mesher/quad_check.h) and writes the quad surface atomically; prints

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 
@@ -88,12 +89,24 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
   options.landmark_file = !s.landmarks.file.empty() ? s.landmarks.file
                           : has_landmarks           ? "the built-in mandible's landmarks"
                                                     : "";
+  if (s.mesh.refine_at_bite) {
+    options.refinement.radius_mm = s.mesh.refine_radius_mm;
+    options.refinement.levels = s.mesh.refine_levels;
+    for (const Support& support : s.supports)
+      if (support.bite) {
+        options.refinement.points.push_back(support.at.xyz);
+        options.refinement.point_names.push_back(support.at.where.str() + ": the bite support " +
+                                                 support.name + "'s point (mesh.refine_at_bite)");
+      }
+  }
   MandibleSheetReport report;
   HexMesh mesh;
   try {
     mesh = mesh_mandible_by_sheets(geometry.surface, has_landmarks ? &geometry.landmarks : nullptr, options,
                                    &report);
   } catch (const InputError& e) {
+    // A bite point off the bone: the message already names the support's line and the key.
+    if (std::string(e.what()).find("(mesh.refine_at_bite)") != std::string::npos) throw;
     throw InputError(
         s.mesh.method_at.str() + ": mesh.method 'sheets' cannot place its mandible template: " + e.what() +
         "; give landmarks with the template's points, or use method: grid for a bone that is not a "
@@ -102,6 +115,17 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     throw RunError(std::string("the sheet mesher failed: ") + e.what() + "; use method: grid");
   }
   *fidelity = report.fidelity;
+  for (const LocalRefinementSite& site : report.refinement.sites) {
+    char line[256];
+    std::snprintf(
+        line, sizeof line,
+        "mesh.refine_at_bite: %d rings at (%.1f, %.1f, %.1f) mm, mean quad edge within %.1f mm %.2f "
+        "-> %.2f mm (+%d quads in all)",
+        report.refinement.levels, site.on_surface[0], site.on_surface[1], site.on_surface[2],
+        s.mesh.refine_radius_mm, site.mean_edge_before_mm, site.mean_edge_after_mm,
+        report.refinement.quads_added);
+    info(line);
+  }
   if (report.inverted > 0)
     throw RunError("the sheet mesher left " + std::to_string(report.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) + ": " +

@@ -418,6 +418,26 @@ std::array<int, 8> cube_hex(const std::array<Quad, 6>& cube) {
   return h;
 }
 
+// The chord through the edge {rung[0], rung[1]} of the current surface, or -1 when there is no such edge.
+int chord_of_rung(const QuadEdges& qe, const std::vector<Chord>& chords, const std::array<int, 2>& rung) {
+  const std::array<int, 2> key{std::min(rung[0], rung[1]), std::max(rung[0], rung[1])};
+  const auto it = std::lower_bound(qe.edges.begin(), qe.edges.end(), key);
+  if (key[0] == key[1] || it == qe.edges.end() || *it != key) return -1;
+  const int e = static_cast<int>(it - qe.edges.begin());
+  for (int c = 0; c < static_cast<int>(chords.size()); ++c)
+    if (std::find(chords[c].edges.begin(), chords[c].edges.end(), e) != chords[c].edges.end()) return c;
+  return -1;
+}
+
+// Vertex v's id after `step`: a Q-side rail vertex becomes its rung partner, an interior vertex of Q its
+// fresh id (`fresh`: sorted (old, new) pairs); others keep theirs.
+int renamed(int v, const Step& step, const std::vector<std::pair<int, int>>& fresh) {
+  for (std::size_t i = 0; i < step.rung_from.size(); ++i)
+    if (step.rung_from[i] == v) return step.rung_to[i];
+  const auto it = std::lower_bound(fresh.begin(), fresh.end(), std::make_pair(v, -1));
+  return it != fresh.end() && it->first == v ? it->second : v;
+}
+
 }  // namespace
 
 EliminationOrder parse_elimination_order(const std::string& name) {
@@ -450,20 +470,29 @@ EliminationScheme eliminate_chords(const QuadSurface& surface, const Elimination
   int next_id = scheme.input_vertices;
   std::vector<Vec3> positions = surface.vertices;  // of the current surface, for the geometric order
   std::vector<Quad> quads = surface.quads;
+  std::vector<std::array<int, 2>> first_rungs = options.first_rungs;  // ids followed through collapses
+  std::size_t first = 0;                                              // the next of them
   while (quads.size() > 6) {
     const QuadEdges qe = build_quad_edges(quads);
     const std::vector<Chord> chords = find_chords(quads, qe);
     const Candidates candidates = ordered_candidates(quads, qe, chords, options.order, &positions);
     const Step* chosen = nullptr;
     std::vector<Quad> next;
-    for (const Step& s : candidates.steps) {
+    auto feasible = [&](const Step& s) {
       std::vector<Quad> collapsed = collapse(quads, chords, s);
-      if (!is_polyhedral_ball(collapsed)) continue;
-      if (options.order != EliminationOrder::kFewestHexes && !has_feasible_chord(collapsed)) continue;
+      if (!is_polyhedral_ball(collapsed)) return false;
+      if (options.order != EliminationOrder::kFewestHexes && !has_feasible_chord(collapsed)) return false;
       chosen = &s;
       next = std::move(collapsed);
-      break;
+      return true;
+    };
+    while (!chosen && first < first_rungs.size()) {
+      const int c = chord_of_rung(qe, chords, first_rungs[first++]);
+      for (const Step& s : candidates.steps)
+        if (c >= 0 && s.chords.size() == 1 && s.chords[0] == c && feasible(s)) break;
     }
+    for (const Step& s : candidates.steps)
+      if (chosen || feasible(s)) break;
     if (!chosen)
       throw RunError(
           stuck_message(quads, chords, static_cast<int>(scheme.eliminations.size()), scheme.input_vertices));
@@ -509,6 +538,8 @@ EliminationScheme eliminate_chords(const QuadSurface& surface, const Elimination
     }
     scheme.eliminations.push_back(std::move(step));
     quads = std::move(next);
+    for (std::size_t i = first; i < first_rungs.size(); ++i)
+      for (int& v : first_rungs[i]) v = renamed(v, *chosen, fresh);
   }
   std::copy(quads.begin(), quads.end(), scheme.cube.begin());
   scheme.total_vertices = next_id;

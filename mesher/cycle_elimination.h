@@ -107,6 +107,12 @@ struct EliminationOptions {
   // The best measured (docs/sheets.md): equal to the others on blocks, polycubes, box chains and spheres,
   // as good on the jaw's quad surface, valid where they leave inverted hexes (the O-grid disk).
   EliminationOrder order = EliminationOrder::kGeometric;
+  // Chords to eliminate before the order chooses, each named by one of its rungs (an edge {a, b} of the
+  // input surface), in this order: at its turn a rung still on a simple chord whose single elimination is
+  // feasible (and, in the look-ahead orders, no dead end) is eliminated on its smaller side; rungs that a
+  // collapse removed, and infeasible ones, are skipped (ids merged by a collapse are followed). Used for
+  // the ring chords of a local refinement (mesher/quad_local_refinement.h).
+  std::vector<std::array<int, 2>> first_rungs;
 };
 
 // Step 1. Throws InputError when the surface is not usable and RunError when no feasible chord is left.

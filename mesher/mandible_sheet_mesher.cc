@@ -1,6 +1,8 @@
 #include "mesher/mandible_sheet_mesher.h"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "common/error.h"
 #include "common/progress.h"
@@ -58,12 +60,17 @@ OptimizeOptions surface_optimizer_options() {
 
 QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* landmarks, int target_quads,
                                    const std::string& surface_name, const std::string& landmark_file,
-                                   MandibleQuadReport* report, QuadSurfaceReport* check) {
+                                   MandibleQuadReport* report, QuadSurfaceReport* check,
+                                   const LocalRefinementOptions& refinement,
+                                   LocalRefinementReport* refinement_report) {
   MandibleQuadOptions options;
   options.target_quads = target_quads;
   QuadSurface quads;
   try {
     quads = quad_surface_from_mandible(surface, landmarks, landmark_file, options, report);
+    if (refinement.enabled())
+      quads = refine_quads_locally(quads, SurfaceProjector(surface), report->landmark_vertices, refinement,
+                                   refinement_report);
   } catch (const InputError& e) {
     throw InputError("'" + surface_name + "': " + e.what());
   }
@@ -73,6 +80,15 @@ QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* l
     for (const auto& p : check->problems) problems += "; " + p;
     throw RunError("the quad surface built for '" + surface_name + "' fails its check" + problems);
   }
+  if (refinement.enabled()) {
+    report->quads = check->quads;
+    report->chords = static_cast<int>(check->chords.size());
+    report->max_chord_length = 0;
+    for (const Chord& c : check->chords)
+      report->max_chord_length = std::max(report->max_chord_length, c.length());
+    report->mean_edge_mm =  // over every edge: an infinite radius
+        mean_edge_near(quads, Vec3{0, 0, 0}, std::numeric_limits<double>::infinity());
+  }
   return quads;
 }
 
@@ -81,13 +97,16 @@ HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* land
   MandibleSheetReport local;
   MandibleSheetReport& report = report_out ? *report_out : local;
   report = MandibleSheetReport{};
-  const QuadSurface quads =
-      checked_mandible_quads(surface, landmarks, quads_for_target_hexes(o.target_hexes), o.surface_name,
-                             o.landmark_file, &report.quad, &report.quad_check);
+  const QuadSurface quads = checked_mandible_quads(surface, landmarks, quads_for_target_hexes(o.target_hexes),
+                                                   o.surface_name, o.landmark_file, &report.quad,
+                                                   &report.quad_check, o.refinement, &report.refinement);
 
   // Step 2. Cycle elimination keeps the quad vertices' ids, so the landmark vertices stay valid.
   SheetMeshOptions options;
   options.elimination.order = o.order;
+  // The refinement's ring chords first: their collapse gives back the unrefined quads, whose elimination
+  // then runs as without refinement, and the rings become pillow sheets under the patch.
+  options.elimination.first_rungs = report.refinement.ring_rungs;
   options.optimize = false;
   SheetMeshReport& sheets = report.sheets;
   HexMesh mesh;

@@ -8,7 +8,9 @@
 // the surface's extreme points place the template), and a target number of hexes.
 // Algorithm:
 //   1. The quad surface: quad_surface_from_mandible() (mesher/quad_surface_placement.h) with
-//      quads_for_target_hexes(target_hexes) quads, then check_quad_surface() (mesher/quad_check.h).
+//      quads_for_target_hexes(target_hexes) quads, optionally refined around points (the bite point) by
+//      refine_quads_locally() (mesher/quad_local_refinement.h), then check_quad_surface()
+//      (mesher/quad_check.h).
 //   2. Cycle elimination (mesher/cycle_elimination.h) in the given order; the sheet mesher only smooths the
 //      interior (its own optimizer would hold the whole boundary fixed).
 //   3. A pillow layer under the quad surface: every quad vertex gets an inner copy, which takes its place in
@@ -39,6 +41,7 @@
 #include "mesher/hex_mesh.h"
 #include "mesher/landmarks.h"
 #include "mesher/quad_check.h"
+#include "mesher/quad_local_refinement.h"
 #include "mesher/quad_surface_placement.h"
 
 namespace hexbite {
@@ -48,11 +51,13 @@ struct MandibleSheetOptions {
   EliminationOrder order = EliminationOrder::kGeometric;
   std::string surface_name = "the surface";  // names the input in error messages
   std::string landmark_file;                 // names the landmarks in error messages
+  LocalRefinementOptions refinement;         // around refinement.points; none by default
 };
 
 struct MandibleSheetReport {
-  MandibleQuadReport quad;       // the quad surface: placement, density, distance to the input
-  QuadSurfaceReport quad_check;  // its check (usable, or the mesher throws)
+  MandibleQuadReport quad;           // the quad surface: placement, density, distance to the input
+  QuadSurfaceReport quad_check;      // its check (usable, or the mesher throws)
+  LocalRefinementReport refinement;  // empty sites when no refinement was asked for
   // Cycle elimination; hexes, interior_vertices, quality, optimize and seconds_embedding describe the final
   // mesh (pillow layer and sliding optimization included).
   SheetMeshReport sheets;
@@ -61,11 +66,15 @@ struct MandibleSheetReport {
   int inverted = 0;       // hexes left inverted; sheets.quality.inverted_hexes lists them
 };
 
-// Step 1 alone (`hexbite quad from-mandible`): the quad surface of about target_quads quads, checked.
-// `report` and `check` must not be null. Throws as described above.
+// Step 1 alone (`hexbite quad from-mandible`): the quad surface of about target_quads quads, refined
+// locally when `refinement` has points (the landmark nodes stay fixed), checked. `report` and `check` must
+// not be null; report's quads, chords, max_chord_length and mean_edge_mm then describe the refined surface,
+// its distances the surface before the refinement. Throws as described above.
 QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* landmarks, int target_quads,
                                    const std::string& surface_name, const std::string& landmark_file,
-                                   MandibleQuadReport* report, QuadSurfaceReport* check);
+                                   MandibleQuadReport* report, QuadSurfaceReport* check,
+                                   const LocalRefinementOptions& refinement = {},
+                                   LocalRefinementReport* refinement_report = nullptr);
 
 // Steps 1 to 5. `landmarks` may be null (extreme points place the template); `report` may be null.
 HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* landmarks,

@@ -930,4 +930,8 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   return fine;
 }
 
+std::vector<Vec3> quad_vertex_normals(const QuadSurface& quads) {
+  return vertex_normals(quads);
+}
+
 }  // namespace hexbite

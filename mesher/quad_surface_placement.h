@@ -128,4 +128,8 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
 // paper's density), scaling with the 2/3 power, rounded to an even number.
 int quads_for_target_hexes(long target_hexes);
 
+// Unit area-weighted vertex normals of a quad surface (each quad split along both diagonals), as the
+// placement uses them; mesher/quad_local_refinement.cc takes its fold reference from them.
+std::vector<Vec3> quad_vertex_normals(const QuadSurface& quads);
+
 }  // namespace hexbite

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "mesher/quad_local_refinement.h"
 #include "mesher/units.h"
 
 namespace hexbite {
@@ -388,7 +389,8 @@ LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, cons
 }
 
 MeshSettings parse_mesh(const Value& v) {
-  const Map map(v, {"method", "target_hexes", "validation_levels"});
+  const Map map(v, {"method", "target_hexes", "validation_levels", "refine_at_bite", "refine_radius_mm",
+                    "refine_levels"});
   MeshSettings m;
   if (auto x = map.find("method")) {
     m.method = to_choice<MeshMethod>(*x, {{"grid", MeshMethod::kGrid}, {"sheets", MeshMethod::kSheets}});
@@ -404,6 +406,32 @@ MeshSettings parse_mesh(const Value& v) {
     if (m.validation_levels < 0 || m.validation_levels > 3)
       fail(x->at, "mesh.validation_levels is " + std::to_string(m.validation_levels) +
                       " but must be 0 (none), 1, 2 or 3; each level refines the mesh 8-way and solves again");
+  }
+  if (auto x = map.find("refine_at_bite")) {
+    m.refine_at_bite = to_bool(*x);
+    m.refine_at_bite_at = x->at;
+    if (m.refine_at_bite && m.method != MeshMethod::kSheets)
+      fail(x->at,
+           "mesh.refine_at_bite refines the quad surface of the sheet mesher, but mesh.method is grid" +
+               std::string(m.method_at.line ? "" : " (the default)") +
+               "; write method: sheets in mesh, or remove refine_at_bite");
+  }
+  if (auto x = map.find("refine_radius_mm")) {
+    m.refine_radius_mm = to_number(*x);
+    if (!m.refine_at_bite)
+      fail(x->at, "mesh.refine_radius_mm needs refine_at_bite: true in mesh; add it or remove this key");
+    if (m.refine_radius_mm < kMinRefineRadiusMm || m.refine_radius_mm > kMaxRefineRadiusMm)
+      fail(x->at, "mesh.refine_radius_mm is " + fmt(m.refine_radius_mm) + " but must be from " +
+                      fmt(kMinRefineRadiusMm) + " to " + fmt(kMaxRefineRadiusMm) + " mm; the default is 8");
+  }
+  if (auto x = map.find("refine_levels")) {
+    m.refine_levels = to_int(*x);
+    if (!m.refine_at_bite)
+      fail(x->at, "mesh.refine_levels needs refine_at_bite: true in mesh; add it or remove this key");
+    if (m.refine_levels < 1 || m.refine_levels > kMaxRefineLevels)
+      fail(x->at, "mesh.refine_levels is " + std::to_string(m.refine_levels) + " but must be from 1 to " +
+                      std::to_string(kMaxRefineLevels) +
+                      " (rings of quads around the bite point); the default is 3");
   }
   return m;
 }
@@ -593,9 +621,9 @@ SolverSpec parse_solver(const Value& v) {
       fail(x->at, "solver.degree is " + std::to_string(s.degree) + "; use 1 (Q1) or 2 (Q2)");
   }
   if (auto x = map.find("linear_solver"))
-    s.linear_solver = to_choice<LinearSolverChoice>(
-        *x,
-        {{"auto", LinearSolverChoice::kAuto}, {"cg_amg", LinearSolverChoice::kCgAmg}, {"direct", LinearSolverChoice::kDirect}});
+    s.linear_solver = to_choice<LinearSolverChoice>(*x, {{"auto", LinearSolverChoice::kAuto},
+                                                         {"cg_amg", LinearSolverChoice::kCgAmg},
+                                                         {"direct", LinearSolverChoice::kDirect}});
   if (auto x = map.find("tolerance")) {
     s.tolerance = to_number(*x);
     if (s.tolerance <= 0 || s.tolerance >= 1)
@@ -701,6 +729,11 @@ Scenario parse_scenario(const Ctx& ctx, const YAML::Node& root_node) {
   check_unique_names(s.supports, "support");
   check_unique_names(s.probes, "probe");
   check_loads_and_supports(s, root);
+  if (s.mesh.refine_at_bite &&
+      std::none_of(s.supports.begin(), s.supports.end(), [](const Support& x) { return x.bite; }))
+    fail(s.mesh.refine_at_bite_at,
+         "mesh.refine_at_bite refines around the bite supports' points, but no support has bite: true; mark "
+         "the biting patch with bite: true, or remove refine_at_bite");
   return s;
 }
 

@@ -67,6 +67,12 @@ struct MeshSettings {
   int target_hexes = 2500;
   int validation_levels = 1;  // each level is one 8-way refinement solved again
   SourceLocation method_at;   // where `method` was written (empty when it was left at its default)
+  // method sheets only: refine the quad surface around every bite support's point
+  // (mesher/quad_local_refinement.h), with this patch radius and number of rings.
+  bool refine_at_bite = false;
+  double refine_radius_mm = 8.0;
+  int refine_levels = 3;
+  SourceLocation refine_at_bite_at;  // where refine_at_bite was written
 };
 
 struct MaterialSpec {

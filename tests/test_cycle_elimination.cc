@@ -295,6 +295,40 @@ TEST(CycleElimination, InternalSheetUnderAPillowedPatch) {
   EXPECT_EQ(std::count(kinds.begin(), kinds.end(), SheetKind::kInternal), 1);
 }
 
+// EliminationOptions::first_rungs: chords named by a rung go first, in the given order, with ids followed
+// through the collapses; rungs that are gone or no edge are skipped. On the 4 x 2 x 2 block fewest-hexes
+// starts with an end face (4 hexes); named first, the y-chord through (2, 0, 0)-(2, 1, 0) takes the y = 0
+// face (8 hexes); its other rung is gone after it; the z-edge at the origin, renamed by that collapse to
+// (0, 1, 0)-(0, 1, 1), then gives the z = 0 face of the 4 x 1 x 2 block (4 hexes, where fewest-hexes would
+// take 2). The result is still the block's 16 hexes.
+TEST(CycleElimination, FirstRungsAreEliminatedFirst) {
+  const QuadSurface s = test::block_surface(4, 2, 2);
+  auto at = [&](const Vec3& p) { return test::vertex_at(s, p); };
+  EliminationOptions options;
+  options.order = EliminationOrder::kFewestHexes;
+  const EliminationScheme plain = eliminate_chords(s, options);
+  ASSERT_GE(plain.eliminations.size(), 2u);
+  EXPECT_EQ(plain.eliminations[0].hexes.size(), 4u);
+  options.first_rungs = {{at({2, 0, 0}), at({2, 1, 0})},
+                         {at({3, 0, 0}), at({3, 1, 0})},
+                         {0, 0},
+                         {-1, 1000},
+                         {at({0, 0, 0}), at({0, 0, 1})}};
+  const EliminationScheme first = eliminate_chords(s, options);
+  ASSERT_GE(first.eliminations.size(), 2u);
+  EXPECT_EQ(first.eliminations[0].hexes.size(), 8u);
+  EXPECT_EQ(first.eliminations[0].chord_length, 12);
+  EXPECT_EQ(first.eliminations[1].hexes.size(), 4u);
+  EXPECT_EQ(first.eliminations[1].quads_before, 40 - 12);
+  EXPECT_EQ(build_hex_complex(s, first).hexes.size(), 16u);
+  SheetMeshOptions mesh_options;
+  mesh_options.elimination = options;
+  SheetMeshReport r;
+  expect_boundary_equals_input(mesh_by_cycle_elimination(s, mesh_options, &r), s);
+  EXPECT_EQ(r.quality.inverted, 0);
+  EXPECT_NEAR(r.quality.scaled_jacobian.min, 1.0, 1e-9);
+}
+
 TEST(CycleElimination, NoSchemeIsARunErrorNamingTheChords) {
   const QuadSurface s = test::no_scheme_surface();
   ASSERT_TRUE(check_quad_surface(s, "").usable());
