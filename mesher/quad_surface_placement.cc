@@ -706,13 +706,8 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
       const SurfacePoint sp = quad_projector.closest(p);
       const int q0 = sp.triangle / 4;
       if (touched[q0]) continue;  // its quads changed this round: the distances are stale
-      // The free nodes of that quad, nearest first; the first whose move is kept.
-      std::array<int, 4> nodes = fine.quads[q0];
-      std::sort(nodes.begin(), nodes.end(), [&](int x, int y) {
-        return std::pair{norm(sub(fine.vertices[x], p)), x} < std::pair{norm(sub(fine.vertices[y], p)), y};
-      });
-      for (int v : nodes) {
-        if (fixed[v]) continue;
+      // Moves v to goal if that keeps the local quality and lowers the local error (then v is fixed).
+      auto try_move = [&](int v, const Vec3& goal) {
         const std::vector<int>& quads = vertex_quads[v];
         // Local error: the largest distance of p and of the input vertices charged to v's quads to those
         // quads, and of the quads' sampled points to the input (cached per quad); local quality: the
@@ -734,9 +729,9 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
         for (int q : quads) before = std::max(before, sample_error[q]);
         const double before_quality = quality();
         const Vec3 old_point = fine.vertices[v], old_normal = (*surface_normal)[v];
-        fine.vertices[v] = p;
-        (*surface_normal)[v] = s.projector.closest(p).normal;
-        if (quality() > std::min(before_quality, kSnapQuality) && charged_error() < before - 1e-6) {
+        fine.vertices[v] = goal;
+        (*surface_normal)[v] = s.projector.closest(goal).normal;
+        if (quality() >= std::min(before_quality, kSnapQuality) && charged_error() < before - 1e-6) {
           std::vector<double> after_samples;
           double after = 0;
           for (int q : quads) {
@@ -750,11 +745,33 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
             }
             fixed[v] = 1;
             ++moved;
-            break;
+            return true;
           }
         }
         fine.vertices[v] = old_point;
         (*surface_normal)[v] = old_normal;
+        return false;
+      };
+      // The free nodes of that quad, nearest first, each moved all the way onto p, then 3/4 and 1/2 of the
+      // way (restricted projection); the first move kept ends the search.
+      std::array<int, 4> nodes = fine.quads[q0];
+      std::sort(nodes.begin(), nodes.end(), [&](int x, int y) {
+        return std::pair{norm(sub(fine.vertices[x], p)), x} < std::pair{norm(sub(fine.vertices[y], p)), y};
+      });
+      bool kept = false;
+      for (int v : nodes) {
+        for (double fraction : {1.0, 0.75, 0.5}) {
+          if (kept || fixed[v]) break;
+          Vec3 goal = p;
+          if (fraction < 1.0) {
+            const SurfacePoint partial =
+                s.oriented.closest(add(fine.vertices[v], scale(sub(p, fine.vertices[v]), fraction)),
+                                   (*surface_normal)[v], Vec3{0, 0, 0});
+            if (partial.triangle < 0) continue;
+            goal = partial.point;
+          }
+          kept = try_move(v, goal);
+        }
       }
     }
     if (moved == 0) break;

@@ -50,25 +50,28 @@
 //      comes to bridge a gap); this never lowers the surface's smallest agreement.
 //   8. Feature snapping. The input vertices farther than snap_threshold_mm from the quads (cusp tips,
 //      condyle poles, crests that the quads cut off), farthest first, pull a free node of their nearest quad
-//      (nearest node first) exactly onto themselves; the move is kept only when it lowers the local error
-//      (the distance of that vertex and of the input vertices nearest to the node's quads to those quads,
-//      and of the quads' inner sample points to the input) and keeps the smallest corner scaled Jacobian
-//      of the node's quads (sine of the corner angle, signed by the input normal) above 0.3 or above what
-//      it was; snapped nodes stay fixed. Up to snap_rounds rounds, each re-measuring the distances.
+//      (nearest node first) exactly onto themselves, or failing that 3/4 or 1/2 of the way (restricted
+//      projection); the move is kept only when it lowers the local error (the distance of that vertex and
+//      of the input vertices nearest to the node's quads to those quads, and of the quads' inner sample
+//      points to the input) and keeps the smallest corner scaled Jacobian of the node's quads (sine of the
+//      corner angle, signed by the input normal) at least at 0.3 or at what it was; snapped nodes stay
+//      fixed. Up to snap_rounds rounds, each re-measuring the distances.
 //   9. Fidelity. Vertex distance to the input, quad-to-surface distance sampled on each bilinear quad, and
 //      surface-to-quads distance of every input vertex (CGAL AABB trees, mesher/surface_projector.h); folded
 //      quads (a corner normal against the surface normal).
-// Limitations (measured, docs/mandible_quads.md): at 1,300 quads the Hausdorff distance is 1.2 mm on the
-// built-in mandible and 2.0 to 2.6 mm on the real jaw (1 mm is the goal; the farthest points are on the
-// condyle heads and the real jaw's incisal edges and molar crowns, finer than the 3.6 mm quads), and at 3,000
+// Limitations (measured, docs/mandible_quads.md): at 1,300 quads the Hausdorff distance is 1.1 mm on the
+// built-in mandible and 1.4 to 1.7 mm on the real jaw (1 mm is the goal; the farthest points are on the
+// condyle heads and necks and the real jaw's coronoid tips, incisal edges and molar crowns, finer than the
+// 3.6 mm quads, where a snapped node would bend a quad corner below 0.3), and at 3,000
 // quads a few quads still fold (3) and the distance is 3.3 to 6.6 mm (gaps on the lingual side of the body
 // that the snapping does not close). Failure: InputError when a landmark file lacks the points the template
 // needs (naming the file and the missing names), when the surface is not mandible-like (its Hausdorff
 // distance to the placed template exceeds 10 mm, naming where), or when the target is out of range. Cost: O(T
 // log T) for T input triangles plus O((Q + V) sweeps) for Q quads and V input vertices (the Lloyd
 // assignment), plus about a thousand closest-point queries per node of a folded quad and untangling sweep,
-// plus per snapping round O(V log Q + Q) closest-point queries and local checks of the far vertices; about
-// 0.9 to 1.3 s for 50,000 triangles and 1,300 quads. Deterministic (single-threaded, fixed orders).
+// plus per snapping round O(V log Q + Q) closest-point queries and local checks of the far vertices; 1.0
+// to 2.5 s for 50,000 triangles and 1,300 quads, measured while other builds shared the 2-core machine.
+// Deterministic (single-threaded, fixed orders).
 #pragma once
 
 #include <string>
@@ -89,7 +92,7 @@ struct MandibleQuadOptions {
   double landmark_smoothing_mm = 0.5;
   double insertion_smoothing_mm = 50.0;
   double extreme_smoothing_mm = 20.0;
-  int snap_rounds = 4;             // step 8; 0 turns feature snapping off
+  int snap_rounds = 8;             // step 8; 0 turns feature snapping off
   double snap_threshold_mm = 1.0;  // input vertices farther than this from the quads pull a node
   double max_hausdorff_mm = 10.0;  // above this the surface is not taken for a mandible
 };
