@@ -333,12 +333,50 @@ void corner_measures_min(const HexMesh& mesh, const std::vector<CornerRef>& corn
   }
 }
 
+// One ascent step of node v for the worst-element pass and the mean stage: a damped Gauss-Newton step on a
+// soft-minimum model with gradient `grad` and negated Hessian model `neg_hess` (both per unit of the edge
+// length h), capped at 0.1 edge and halved up to 8 times until `better()` holds at the trial position. A
+// sliding node steps in its tangent plane, is projected back, and never steps farther from `home` than
+// `reach` or than it already is. Returns true when the step was accepted (the node is then at the new
+// position, else where it was).
+template <class Better>
+bool ascent_step(HexMesh& mesh, int v, double h, bool sliding, const SurfaceProjector* surface,
+                 const Vec3& home, double reach, const Eigen::Vector3d& grad, const Eigen::Matrix3d& neg_hess,
+                 Better better) {
+  SurfacePoint here;
+  if (sliding) here = surface->closest(mesh.vertices[v]);
+  const Eigen::MatrixXd b = step_basis(sliding ? &here : nullptr);
+  const int dims = static_cast<int>(b.cols());
+  const Eigen::VectorXd rg = b.transpose() * grad;
+  if (!(rg.norm() > 0.0)) return false;
+  Eigen::MatrixXd rh = b.transpose() * neg_hess * b;
+  const double damping = 1e-3 * (rh.trace() / dims) + 1e-12 + 1e-1 * rg.norm();
+  rh += damping * Eigen::MatrixXd::Identity(dims, dims);
+  Eigen::VectorXd step = rh.ldlt().solve(rg);
+  if (!step.allFinite() || step.dot(rg) <= 0) step = rg;
+  Eigen::Vector3d dp = h * (b * step);  // back to length units
+  const double max_len = 0.1 * h;
+  if (dp.norm() > max_len) dp *= max_len / dp.norm();
+
+  const Vec3 old = mesh.vertices[v];
+  for (int bt = 0; bt < 8; ++bt, dp *= 0.5) {
+    Vec3 trial = {old[0] + dp[0], old[1] + dp[1], old[2] + dp[2]};
+    if (sliding) {
+      trial = surface->closest(trial, here).point;
+      if (norm(sub(trial, home)) > std::max(reach, norm(sub(old, home)))) continue;
+    }
+    mesh.vertices[v] = trial;
+    if (better()) return true;
+  }
+  mesh.vertices[v] = old;
+  return false;
+}
+
 // One worst-element visit of node v: ascent on the soft minimum S(p) = -(1/mu) log sum exp(-mu m_i(p))
 // of the measures m_i of the corners that depend on p (scaled Jacobian and 3 / kappa with `with_kappa`,
-// else the scaled Jacobian alone), with the untangler's damped Gauss-Newton model of its Hessian. A step
-// is accepted only when the true minimum of the m_i grows and no corner's 3 / kappa falls below the
-// smaller of its old minimum and `q_floor`. A sliding node steps in its tangent plane, is projected back,
-// and never steps farther from `home` than `reach` or than it already is. Returns true when the node moved.
+// else the scaled Jacobian alone), with the untangler's damped Gauss-Newton model of its Hessian
+// (ascent_step). A step is accepted only when the true minimum of the m_i grows and no corner's 3 / kappa
+// falls below the smaller of its old minimum and `q_floor`. Returns true when the node moved.
 bool raise_worst_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sliding,
                       const SurfaceProjector* surface, const Vec3& home, double reach, bool with_kappa,
                       double q_floor, std::vector<CornerRef>& corners) {
@@ -373,38 +411,105 @@ bool raise_worst_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool
     Eigen::Matrix3d neg_hess = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < m.size(); ++i) neg_hess += (w[i] / z) * g[i] * g[i].transpose();
     neg_hess = mu * (neg_hess - grad * grad.transpose());
-    SurfacePoint here;
-    if (sliding) here = surface->closest(mesh.vertices[v]);
-    const Eigen::MatrixXd b = step_basis(sliding ? &here : nullptr);
-    const int dims = static_cast<int>(b.cols());
-    const Eigen::VectorXd rg = b.transpose() * grad;
-    if (!(rg.norm() > 0.0)) break;
-    Eigen::MatrixXd rh = b.transpose() * neg_hess * b;
-    const double damping = 1e-3 * (rh.trace() / dims) + 1e-12 + 1e-1 * rg.norm();
-    rh += damping * Eigen::MatrixXd::Identity(dims, dims);
-    Eigen::VectorXd step = rh.ldlt().solve(rg);
-    if (!step.allFinite() || step.dot(rg) <= 0) step = rg;
-    Eigen::Vector3d dp = h * (b * step);  // back to length units
-    const double max_len = 0.1 * h;
-    if (dp.norm() > max_len) dp *= max_len / dp.norm();
-
-    const Vec3 old = mesh.vertices[v];
-    bool accepted = false;
-    for (int bt = 0; bt < 8 && !accepted; ++bt, dp *= 0.5) {
-      Vec3 trial = {old[0] + dp[0], old[1] + dp[1], old[2] + dp[2]};
-      if (sliding) {
-        trial = surface->closest(trial, here).point;
-        if (norm(sub(trial, home)) > std::max(reach, norm(sub(old, home)))) continue;
-      }
-      mesh.vertices[v] = trial;
+    const bool accepted = ascent_step(mesh, v, h, sliding, surface, home, reach, grad, neg_hess, [&] {
       double s_new, q_new;
       corner_measures_min(mesh, corners, v, s_new, q_new);
-      accepted = (with_kappa ? std::min(s_new, q_new) : s_new) > mmin + 1e-6 && q_new >= q_limit;
+      return (with_kappa ? std::min(s_new, q_new) : s_new) > mmin + 1e-6 && q_new >= q_limit;
+    });
+    if (!accepted) break;
+    moved = true;
+  }
+  return moved;
+}
+
+// True when corner k of a hex depends on the hex's node at local index l (the corner itself or one of its
+// three neighbours).
+bool corner_uses(int k, int l) {
+  const int* nb = kHexCornerNeighbours[k];
+  return k == l || nb[0] == l || nb[1] == l || nb[2] == l;
+}
+
+// One mean visit of node v: ascent on the sum, over the hexes around v, of a soft minimum (mu = 30) of each
+// hex's eight corner scaled Jacobians (a smooth stand-in for the element values whose mean is reported),
+// with the same step as the worst-element visits (ascent_step). A step is accepted only when the sum of the
+// true element values of those hexes grows, none of them falls below the smaller of its old value and
+// `sj_floor`, and no corner that depends on v gets a 3 / kappa below the smaller of its old smallest and
+// `q_floor`. Returns true when the node moved.
+bool raise_mean_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sliding,
+                     const SurfaceProjector* surface, const Vec3& home, double reach, double sj_floor,
+                     double q_floor) {
+  const int first = adj.hex_start[v], last = adj.hex_start[v + 1];
+  if (first == last) return false;
+  const double mu = 30.0;
+  // The element scaled Jacobians of the hexes around v (in adjacency order) and their sum, and the smallest
+  // 3 / kappa of the corners that depend on v; with `grad`, also the soft-minimum model's gradient and
+  // negated Hessian (added to).
+  auto evaluate = [&](double& sum, std::vector<double>& element, double& q_min, Eigen::Vector3d* grad,
+                      Eigen::Matrix3d* neg_hess) {
+    sum = 0.0;
+    q_min = kInf;
+    element.clear();
+    for (int i = first; i < last; ++i) {
+      const int e = adj.hex_list[i];
+      const auto& hx = mesh.hexes[e];
+      int l = 0;
+      while (hx[l] != v) ++l;
+      Vec3 p[8];
+      for (int j = 0; j < 8; ++j) p[j] = mesh.vertices[hx[j]];
+      double s[8];
+      Eigen::Vector3d g[8];
+      double m = kInf;
+      for (int k = 0; k < 8; ++k) {
+        const bool uses = corner_uses(k, l);
+        g[k] = Eigen::Vector3d::Zero();
+        if (uses && grad) {
+          double q;
+          Vec3 gs, gq;
+          corner_measures(mesh, e, k, v, s[k], gs, q, gq);
+          g[k] = Eigen::Vector3d(gs[0], gs[1], gs[2]) * h;  // per unit of the edge length
+          q_min = std::min(q_min, q);
+        } else {
+          // The values alone (as corner_measures computes them).
+          Vec3 a, b, c;
+          hex_corner_columns(p, k, a, b, c);
+          const double len = std::sqrt(dot(a, a) * dot(b, b) * dot(c, c));
+          s[k] = len > 0.0 ? corner_jacobian(a, b, c) / len : 0.0;
+          if (uses) q_min = std::min(q_min, 3.0 / std::sqrt(corner_condition_squared(a, b, c)));
+        }
+        m = std::min(m, s[k]);
+      }
+      sum += m;
+      element.push_back(m);
+      if (!grad) continue;
+      double z = 0.0, w[8];
+      for (int k = 0; k < 8; ++k) z += (w[k] = std::exp(-mu * (s[k] - m)));
+      Eigen::Vector3d ge = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d gg = Eigen::Matrix3d::Zero();
+      for (int k = 0; k < 8; ++k) {
+        ge += (w[k] / z) * g[k];
+        gg += (w[k] / z) * g[k] * g[k].transpose();
+      }
+      *grad += ge;
+      *neg_hess += mu * (gg - ge * ge.transpose());
     }
-    if (!accepted) {
-      mesh.vertices[v] = old;
-      break;
-    }
+  };
+  std::vector<double> before, after;
+  bool moved = false;
+  for (int iter = 0; iter < 4; ++iter) {
+    double sum0, q_min0;
+    Eigen::Vector3d grad = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d neg_hess = Eigen::Matrix3d::Zero();
+    evaluate(sum0, before, q_min0, &grad, &neg_hess);
+    const double q_limit = std::min(q_min0, q_floor);
+    const bool accepted = ascent_step(mesh, v, h, sliding, surface, home, reach, grad, neg_hess, [&] {
+      double sum, q_min;
+      evaluate(sum, after, q_min, nullptr, nullptr);
+      if (!(sum > sum0 + 1e-9 && q_min >= q_limit)) return false;
+      for (std::size_t i = 0; i < after.size(); ++i)
+        if (after[i] < std::min(before[i], sj_floor)) return false;
+      return true;
+    });
+    if (!accepted) break;
     moved = true;
   }
   return moved;
@@ -746,6 +851,50 @@ int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, cons
   return sweeps;
 }
 
+int improve_mean_jacobian(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
+                          const SurfaceProjector* surface, const OptimizeOptions& options,
+                          const std::vector<Vec3>* home_in) {
+  if (options.mean_jacobian_sweeps <= 0 || mesh.hexes.empty()) return 0;
+  int inverted = 0;
+  inverted_mask(mesh, &inverted);
+  if (inverted > 0) return 0;
+  const Adjacency adj(mesh);
+  const std::vector<double> h = local_edge_length(mesh, adj);
+  const std::vector<Vec3> home = home_in ? *home_in : mesh.vertices;
+  // No hex may fall below the larger of the mesh's smallest scaled Jacobian and the worst-element
+  // threshold (nor below its own value where that is lower), no corner's 3 / kappa below the mesh's
+  // smallest: the mesh's worst values never get worse.
+  const HexQualityField field = compute_hex_quality(mesh);
+  const double sj_floor =
+      std::max(options.worst_element_threshold,
+               *std::min_element(field.scaled_jacobian.begin(), field.scaled_jacobian.end()));
+  const double q_floor = 3.0 / *std::max_element(field.condition.begin(), field.condition.end());
+  Progress progress("mean scaled Jacobian");
+  int sweeps = 0;
+  // Every movable node in the first sweep; then only the nodes of hexes in which a node moved.
+  std::vector<char> active(mesh.vertices.size(), 1);
+  for (int sweep = 0; sweep < options.mean_jacobian_sweeps; ++sweep) {
+    std::vector<char> next(mesh.vertices.size(), 0);
+    bool moved = false;
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+      if (!movable[v] || !active[v]) continue;
+      const bool slides = surface != nullptr && !sliding.empty() && sliding[v] != 0;
+      if (!raise_mean_node(mesh, adj, static_cast<int>(v), h[v], slides, surface, home[v],
+                           options.worst_element_reach * h[v], sj_floor, q_floor))
+        continue;
+      moved = true;
+      for (int i = adj.hex_start[v]; i < adj.hex_start[v + 1]; ++i)
+        for (int w : mesh.hexes[adj.hex_list[i]]) next[w] = 1;
+    }
+    ++sweeps;
+    progress.update(double(sweep + 1) / options.mean_jacobian_sweeps, "sweep " + std::to_string(sweep + 1));
+    if (!moved) break;
+    active.swap(next);
+  }
+  progress.finish(std::to_string(sweeps) + " sweeps");
+  return sweeps;
+}
+
 OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface,
                                  const std::vector<char>& fixed, const OptimizeOptions& options) {
   const std::size_t nv = mesh.vertices.size();
@@ -788,6 +937,7 @@ OptimizeReport optimize_hex_mesh(HexMesh& mesh, const SurfaceProjector* surface,
     report.untangle_sweeps += untangle(mesh, movable, sliding, surface, options.max_untangle_sweeps);
   }
   report.worst_element_sweeps = improve_worst_elements(mesh, movable, sliding, surface, options, &entry);
+  report.mean_jacobian_sweeps = improve_mean_jacobian(mesh, movable, sliding, surface, options, &entry);
   report.phases.push_back({"final", summarize_quality(mesh), seconds_since(t0)});
   report.inverted = report.phases.back().quality.inverted;
   valid = inverted_mask(mesh, nullptr);

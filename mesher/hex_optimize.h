@@ -29,11 +29,15 @@
 //      node raise the scaled Jacobian alone, no corner's condition number growing beyond the mesh's
 //      largest. Boundary nodes slide, never to a point farther from where the optimization found them
 //      than worst_element_reach of an edge or than they already are. Both stages repeat
-//      worst_element_rounds times.
+//      worst_element_rounds times;
+//   5. optionally (OptimizeOptions::mean_jacobian_sweeps), sweeps raising the mean element scaled Jacobian:
+//      each node ascends the sum of soft minima of the corner scaled Jacobians of its hexes, no hex falling
+//      below max(the mesh's smallest, worst_element_threshold) or its own value, no condition number
+//      beyond the mesh's largest, boundary nodes sliding as in phase 4.
 // Cost: one sweep is O(m) for m hexes (each corner is evaluated a few times per node that it depends on);
 // the jaw at 2,500 hexes converges in about 70 sweeps (about 55 with reactivate = 0.01); each boundary
 // trial costs one closest-point query, O(log t) for t surface triangles, started from the node's current
-// closest point. The worst-element pass costs O(m) per sweep at most.
+// closest point. The worst-element pass and the mean stage cost O(m) per sweep at most.
 // Deterministic: single-threaded, fixed node and hex orders, no hashing.
 #pragma once
 
@@ -74,6 +78,10 @@ struct OptimizeOptions {
   int scaled_jacobian_sweeps = 0;
   // Both stages of the pass run this many times in turn (the second stage's moves give the first room).
   int worst_element_rounds = 1;
+  // Last, sweeps over every node raising the sum of the element scaled Jacobians (each hex's smallest
+  // corner value, whose mean the quality report gives) of the hexes around it (improve_mean_jacobian;
+  // 0 = none).
+  int mean_jacobian_sweeps = 0;
 };
 
 // One row of the per-phase table.
@@ -89,6 +97,7 @@ struct OptimizeReport {
   int iterations = 0;                // optimization sweeps (per-node Newton steps over all movable nodes)
   int rounds = 0;                    // untangle + optimize cycles
   int worst_element_sweeps = 0;      // sweeps of the worst-element pass (both stages)
+  int mean_jacobian_sweeps = 0;      // sweeps of improve_mean_jacobian
   double energy_before = 0.0;        // sum of squared corner condition numbers, valid hexes only
   double energy_after = 0.0;
   int inverted = 0;  // inverted hexes at the end
@@ -126,5 +135,15 @@ int optimize_condition(HexMesh& mesh, const std::vector<char>& movable, const st
 int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
                            const SurfaceProjector* surface, const OptimizeOptions& options,
                            const std::vector<Vec3>* home = nullptr);
+// Phase 5 on a valid mesh (options.mean_jacobian_sweeps sweeps; does nothing when a hex is inverted):
+// each movable node in turn ascends the sum, over its hexes, of a soft minimum of each hex's eight corner
+// scaled Jacobians, a step accepted only when the sum of their element values grows, no hex falls below the
+// smaller of its value and max(mesh's smallest scaled Jacobian, options.worst_element_threshold), and no
+// corner's condition number grows beyond the mesh's largest, so the mesh's worst values never get worse.
+// After the first sweep only the nodes of hexes in which a node moved are visited. Sliding nodes slide
+// within options.worst_element_reach of `home` as in improve_worst_elements. Returns the number of sweeps.
+int improve_mean_jacobian(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
+                          const SurfaceProjector* surface, const OptimizeOptions& options,
+                          const std::vector<Vec3>* home = nullptr);
 
 }  // namespace hexbite

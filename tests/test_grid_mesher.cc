@@ -154,7 +154,7 @@ TEST(GridMesher, SphereMeetsTheTargets) {
 
 // A box meets the element quality and volume targets, but its sharp edges and corners are rounded: boundary
 // nodes go to their closest surface points and the mesher detects no features. Measured at 2,364 hexes:
-// volume -1.6 %, Hausdorff 1.23 mm = 0.83 mean edge lengths (target 0.5). Asserted as reached.
+// volume -1.9 %, Hausdorff 1.25 mm = 0.85 mean edge lengths (target 0.5). Asserted as reached.
 TEST(GridMesher, BoxQualityMeetsTargetsButSharpEdgesAreRounded) {
   const Outcome o = run(box(30.0, 20.0, 12.0), 2500);
   expect_common(o);
@@ -194,11 +194,11 @@ double distance_outside(const HexMesh& mesh, const Vec3& p) {
 // docs/meshing.md). Reached and asserted: a valid mesh, no hex with two boundary faces, and no part lost:
 // the coronoid processes (temporalis insertions, on the surface) and the condyles (TMJ points, inside the
 // bone) are inside the mesh or close to it, and where a tip falls short it is reported by location. Met: the
-// 5 s budget (3.9 s of CPU for three grids, Release) and SJ min >= 0.3 (0.305, but not robustly: 0.25 at
-// 2,000 and 0.28 at 3,000 hexes; asserted with a margin). Not met, asserted at the measured level instead
-// (measured: mean 0.704, kappa max 10.79, volume -4.17 %, Hausdorff 1.43 mean edge lengths): mean >= 0.85,
-// kappa max <= 10 (the ramus and coronoid plates are 1.7-2 mm thick against 4.6 mm cells, see
-// docs/meshing.md), volume within 3 %, Hausdorff <= 0.5 mean edge.
+// 5 s budget (4.4-4.9 s of CPU for three grids, Release, under load) and SJ min >= 0.3 (0.305, but not
+// robustly: 0.25 at 2,000 and 0.28 at 3,000 hexes; asserted with a margin). Not met, asserted at the
+// measured level instead (measured: mean 0.755, kappa max 10.79, volume -4.27 %, Hausdorff 1.42 mean edge
+// lengths): mean >= 0.85, kappa max <= 10 (the ramus and coronoid plates are 1.7-2 mm thick against 4.6 mm
+// cells, see docs/meshing.md), volume within 3 %, Hausdorff <= 0.5 mean edge.
 TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
   SurfaceReport sr;
   const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0, &sr);
@@ -207,10 +207,10 @@ TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
   const MeshFidelity& f = o.report.fidelity;
   EXPECT_NEAR(double(o.mesh.hexes.size()), 2500.0, 250.0);
   EXPECT_GE(o.quality.scaled_jacobian.min, 0.29);     // reached 0.305; the target 0.3, met here only
-  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.695);   // reached 0.704; the target is 0.85
+  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.745);   // reached 0.755; the target is 0.85
   EXPECT_LE(o.quality.condition.max, 11.2);           // reached 10.79; the target is 10
-  EXPECT_LT(std::fabs(f.volume_difference), 0.045);   // reached 4.17 %; target 3 %
-  EXPECT_LE(f.hausdorff, 1.55 * f.mean_edge_length);  // reached 1.43; target 0.5
+  EXPECT_LT(std::fabs(f.volume_difference), 0.045);   // reached 4.27 %; target 3 %
+  EXPECT_LE(f.hausdorff, 1.55 * f.mean_edge_length);  // reached 1.42; target 0.5
   // The temporalis inserts on the coronoid processes; the supports sit at the condyles.
   const Landmarks lm = read_landmarks(test::shared_data("jaw/landmarks.yaml"));
   for (const char* name : {"left_middle_temporalis.insertion", "right_middle_temporalis.insertion",
@@ -234,7 +234,7 @@ TEST(GridMesher, RealJawAt2500KeepsEveryPartButMissesTheQualityTargets) {
 
 // The built-in mandible (generate_mandible with its defaults) at 2,500 hexes. Met: 0 inverted, SJ min >= 0.3
 // (0.547), kappa max <= 10 (6.53), no part lost. NOT met, asserted at the measured level (measured: SJ mean
-// 0.755, volume -3.33 %, Hausdorff 0.61 mean edge lengths): mean >= 0.85, volume within 3 %, Hausdorff <=
+// 0.792, volume -3.41 %, Hausdorff 0.64 mean edge lengths): mean >= 0.85, volume within 3 %, Hausdorff <=
 // 0.5.
 TEST(GridMesher, BuiltInMandibleAt2500) {
   const GeneratedMandible g = generate_mandible({});
@@ -243,10 +243,10 @@ TEST(GridMesher, BuiltInMandibleAt2500) {
   const MeshFidelity& f = o.report.fidelity;
   EXPECT_NEAR(double(o.mesh.hexes.size()), 2500.0, 250.0);
   EXPECT_GE(o.quality.scaled_jacobian.min, 0.5);     // reached 0.547; the target 0.3 is met
-  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.74);   // reached 0.755; the target is 0.85
+  EXPECT_GE(o.quality.scaled_jacobian.mean, 0.78);   // reached 0.792; the target is 0.85
   EXPECT_LE(o.quality.condition.max, 7.5);           // reached 6.53; the target 10 is met
-  EXPECT_LT(std::fabs(f.volume_difference), 0.036);  // reached 3.33 %; target 3 %
-  EXPECT_LE(f.hausdorff, 0.7 * f.mean_edge_length);  // reached 0.61; target 0.5
+  EXPECT_LT(std::fabs(f.volume_difference), 0.036);  // reached 3.41 %; target 3 %
+  EXPECT_LE(f.hausdorff, 0.7 * f.mean_edge_length);  // reached 0.64; target 0.5
   for (const char* name :
        {"left_coronoid_tip", "right_coronoid_tip", "left_condyle_tmj_point", "right_condyle_tmj_point"})
     EXPECT_LE(distance_outside(o.mesh, g.landmarks.points.at(name)), f.mean_edge_length) << name;
