@@ -10,7 +10,8 @@ namespace hexbite {
 
 namespace {
 bool g_quiet = false;
-}
+thread_local bool t_quiet = false;
+}  // namespace
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -20,16 +21,24 @@ void set_quiet(bool quiet) {
   g_quiet = quiet;
 }
 bool is_quiet() {
-  return g_quiet;
+  return g_quiet || t_quiet;
+}
+
+QuietThread::QuietThread(bool quiet) : before_(t_quiet) {
+  t_quiet = t_quiet || quiet;
+}
+
+QuietThread::~QuietThread() {
+  t_quiet = before_;
 }
 
 void info(const std::string& line) {
-  if (!g_quiet) std::cout << line << '\n';
+  if (!is_quiet()) std::cout << line << '\n';
 }
 
 Progress::Progress(std::string label)
     : label_(std::move(label)),
-      active_(!g_quiet && ::isatty(STDERR_FILENO)),
+      active_(!is_quiet() && ::isatty(STDERR_FILENO)),
       start_(std::chrono::steady_clock::now()),
       last_draw_(start_) {
   if (active_) draw(0.0, "", false);

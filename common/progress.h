@@ -11,7 +11,21 @@ double seconds_since(std::chrono::steady_clock::time_point t0);
 
 // Global verbosity of the command line program; set once from --quiet.
 void set_quiet(bool quiet);
+// Whether output is off: set_quiet(true), or inside a QuietThread on this thread.
 bool is_quiet();
+
+// While it lives, info() and Progress on the constructing thread print nothing when `quiet` (helper threads
+// of a computation whose calling thread shows the progress).
+class QuietThread {
+ public:
+  explicit QuietThread(bool quiet);
+  ~QuietThread();
+  QuietThread(const QuietThread&) = delete;
+  QuietThread& operator=(const QuietThread&) = delete;
+
+ private:
+  bool before_;
+};
 
 // Prints an informational line to stdout unless quiet.
 void info(const std::string& line);

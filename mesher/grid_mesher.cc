@@ -1,12 +1,14 @@
 #include "mesher/grid_mesher.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <queue>
 #include <sstream>
+#include <thread>
 
 #include "common/error.h"
 #include "common/progress.h"
@@ -591,6 +593,67 @@ MeshFidelity measure_fidelity(const HexMesh& mesh, const SurfaceProjector& surfa
   return f;
 }
 
+// One grid of grid_mesh(): steps 1 to 4 on the grid shifted by `shift` cells.
+struct GridAttempt {
+  GridMeshReport report;  // seconds_core, _pillow, _optimize of this grid; no fidelity yet
+  HexMesh mesh;
+  Selection selection;
+  std::vector<Vec3> pillowed;  // the nodes before optimization
+};
+
+GridAttempt run_grid_attempt(const SurfaceProjector& projector, const Vec3& lo, const Vec3& hi, double volume,
+                             const GridMeshOptions& options, const OptimizeOptions& optimize, double shift) {
+  const auto t_attempt = std::chrono::steady_clock::now();
+  GridAttempt out;
+  GridMeshReport& r = out.report;
+  // The cell size: secant steps on log(total hexes) against log(h), where total = core cells + core
+  // boundary quads (one pillow hex each). The count falls like h^-2 to h^-3; start from the slope -2.5.
+  const double target = double(options.target_hexes);
+  Progress progress("grid core");
+  double h = std::cbrt(volume / target);
+  Selection& best = out.selection;
+  double best_error = kInf;
+  double prev_h = 0, prev_total = 0;
+  for (int step = 0; step < 8; ++step) {
+    Selection s = build_selection(projector, lo, hi, h, shift, options.margin);
+    const double total = double(s.core_cells + s.boundary_quads);
+    const double error = std::fabs(total - target) / target;
+    if (s.core_cells > 0 && error < best_error) best_error = error, best = std::move(s);
+    progress.update(double(step + 1) / 8,
+                    "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
+    if (best_error < 0.02) break;
+    double slope = -2.5;
+    if (prev_total > 0 && total > 0 && prev_h != h) {
+      const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
+      if (fitted < -1.0 && fitted > -4.0) slope = fitted;
+    }
+    prev_h = h;
+    prev_total = total;
+    h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
+  }
+  progress.finish();
+  if (best.core_cells == 0)
+    throw InputError("grid mesher: no grid cell fits inside the surface; the solid is too thin for " +
+                     std::to_string(options.target_hexes) + " hexes, ask for more");
+  r.cell_size = best.grid.h;
+  r.grid = best.grid.n;
+  r.cells_added_for_manifold = best.added_for_manifold;
+  r.cells_in_dropped_components = best.dropped;
+  out.mesh = core_mesh(best);
+  r.core_hexes = int(out.mesh.hexes.size());
+  r.seconds_core = seconds_since(t_attempt);
+
+  auto t0 = std::chrono::steady_clock::now();
+  r.pillow_hexes = add_pillow_layer(out.mesh, projector, best.grid.h);
+  r.seconds_pillow = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  out.pillowed = out.mesh.vertices;
+  r.optimize = optimize_hex_mesh(out.mesh, &projector, {}, optimize);
+  r.seconds_optimize = seconds_since(t0);
+  return out;
+}
+
 HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
   if (options.target_hexes < 8)
     throw InputError("grid mesher: the target hex count must be at least 8, got " +
@@ -613,74 +676,51 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   auto worst_measure = [](const QualitySummary& q) {
     return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
   };
-  GridMeshReport report;
-  HexMesh mesh;
-  Selection kept;
-  std::vector<Vec3> kept_pillowed;  // the kept grid's nodes before optimization
   // The mean stage does not lower the worst-element measure that picks the grid, so it runs on the kept
   // grid only.
   OptimizeOptions per_grid = options.optimize;
   per_grid.mean_jacobian_sweeps = 0;
-  for (int attempt = 0; attempt < grids; ++attempt) {
-    const auto t_attempt = std::chrono::steady_clock::now();
-    GridMeshReport r;
-    // The cell size: secant steps on log(total hexes) against log(h), where total = core cells + core
-    // boundary quads (one pillow hex each). The count falls like h^-2 to h^-3; start from the slope -2.5.
-    const double target = double(options.target_hexes);
-    Progress progress("grid core");
-    double h = std::cbrt(volume / target);
-    Selection best;
-    double best_error = kInf;
-    double prev_h = 0, prev_total = 0;
-    for (int step = 0; step < 8; ++step) {
-      Selection s = build_selection(projector, lo, hi, h, shifts[attempt], options.margin);
-      const double total = double(s.core_cells + s.boundary_quads);
-      const double error = std::fabs(total - target) / target;
-      if (s.core_cells > 0 && error < best_error) best_error = error, best = std::move(s);
-      progress.update(double(step + 1) / 8,
-                      "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
-      if (best_error < 0.02) break;
-      double slope = -2.5;
-      if (prev_total > 0 && total > 0 && prev_h != h) {
-        const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
-        if (fitted < -1.0 && fitted > -4.0) slope = fitted;
+  // The grids are independent: up to `threads` of them run at once (the calling thread shows progress,
+  // the others are quiet). Each attempt's result depends only on its shift, and the choice below goes in
+  // grid order, so the mesh does not depend on the number of threads.
+  std::vector<GridAttempt> attempts(grids);
+  std::vector<std::exception_ptr> errors(grids);
+  std::atomic<int> next{0};
+  auto work = [&](bool quiet) {
+    const QuietThread quiet_thread(quiet);
+    for (int a = next++; a < grids; a = next++) {
+      try {
+        attempts[a] = run_grid_attempt(projector, lo, hi, volume, options, per_grid, shifts[a]);
+      } catch (...) {
+        errors[a] = std::current_exception();
       }
-      prev_h = h;
-      prev_total = total;
-      h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
     }
-    progress.finish();
-    if (best.core_cells == 0)
-      throw InputError("grid mesher: no grid cell fits inside the surface; the solid is too thin for " +
-                       std::to_string(options.target_hexes) + " hexes, ask for more");
-    r.cell_size = best.grid.h;
-    r.grid = best.grid.n;
-    r.cells_added_for_manifold = best.added_for_manifold;
-    r.cells_in_dropped_components = best.dropped;
-    HexMesh m = core_mesh(best);
-    r.core_hexes = int(m.hexes.size());
-    r.seconds_core = seconds_since(t_attempt);
+  };
+  const int threads = std::clamp(options.threads, 1, grids);
+  std::vector<std::thread> helpers;
+  for (int t = 1; t < threads; ++t) helpers.emplace_back(work, true);
+  work(false);
+  for (std::thread& t : helpers) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
 
-    auto t0 = std::chrono::steady_clock::now();
-    r.pillow_hexes = add_pillow_layer(m, projector, best.grid.h);
-    r.seconds_pillow = seconds_since(t0);
-
-    t0 = std::chrono::steady_clock::now();
-    std::vector<Vec3> pillowed = m.vertices;
-    r.optimize = optimize_hex_mesh(m, &projector, {}, per_grid);
-    r.seconds_optimize = seconds_since(t0);
-
-    const QualitySummary& q = r.optimize.phases.back().quality;
-    const QualitySummary* kept_q = attempt > 0 ? &report.optimize.phases.back().quality : nullptr;
+  GridMeshReport report;
+  HexMesh mesh;
+  Selection kept;
+  std::vector<Vec3> kept_pillowed;  // the kept grid's nodes before optimization
+  for (int a = 0; a < grids; ++a) {
+    GridAttempt& t = attempts[a];
+    const QualitySummary& q = t.report.optimize.phases.back().quality;
+    const QualitySummary* kept_q = a > 0 ? &report.optimize.phases.back().quality : nullptr;
     if (!kept_q || q.inverted < kept_q->inverted ||
         (q.inverted == kept_q->inverted && worst_measure(q) > worst_measure(*kept_q))) {
-      report = std::move(r);
-      mesh = std::move(m);
-      kept = std::move(best);
-      kept_pillowed = std::move(pillowed);
+      report = std::move(t.report);
+      mesh = std::move(t.mesh);
+      kept = std::move(t.selection);
+      kept_pillowed = std::move(t.pillowed);
     }
-    report.attempts = attempt + 1;
   }
+  report.attempts = grids;
 
   auto t0 = std::chrono::steady_clock::now();
   if (options.optimize.mean_jacobian_sweeps > 0) {

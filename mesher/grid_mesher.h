@@ -28,7 +28,9 @@
 // Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
 // near a surface triangle (for the default negative margin) per trial size; the optimizer dominates. Each
 // grid of step 5 repeats steps 1-4; step 6 runs once.
-// Deterministic: same surface and options, same mesh (bit for bit).
+// Threads: the grids of step 5 run in up to GridMeshOptions::threads threads (default 2, this machine's
+// cores); the calling thread shows progress, the others are quiet (QuietThread, common/progress.h).
+// Deterministic: same surface and options, same mesh (bit for bit), whatever the number of threads.
 #pragma once
 
 #include <string>
@@ -52,6 +54,8 @@ struct GridMeshOptions {
   // Grids tried, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3). The mesh with
   // the fewest inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
   int grids = 3;
+  // Grids meshed at once, each in its own thread (1 to grids); the mesh does not depend on it.
+  int threads = 2;
   // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass, twice,
   // and the mean stage (on the kept grid only).
   OptimizeOptions optimize = [] {

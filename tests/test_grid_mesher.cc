@@ -174,6 +174,19 @@ TEST(GridMesher, DeterministicSameBytes) {
   write_vtu(dir + "/a.vtu", a);
   write_vtu(dir + "/b.vtu", b);
   EXPECT_EQ(test::read_file(dir + "/a.vtu"), test::read_file(dir + "/b.vtu"));
+  // The three grids in one thread, and in three: the same mesh and the same choice.
+  GridMeshReport serial_report, threaded_report;
+  options.threads = 1;
+  const HexMesh serial = grid_mesh(sphere, options, &serial_report);
+  options.threads = 3;
+  const HexMesh threaded = grid_mesh(sphere, options, &threaded_report);
+  EXPECT_EQ(serial.vertices, a.vertices);
+  EXPECT_EQ(serial.hexes, a.hexes);
+  EXPECT_EQ(threaded.vertices, a.vertices);
+  EXPECT_EQ(threaded.hexes, a.hexes);
+  EXPECT_EQ(serial_report.attempts, 3);
+  EXPECT_EQ(threaded_report.attempts, 3);
+  EXPECT_EQ(serial_report.cell_size, threaded_report.cell_size);
 }
 
 // How far a point lies outside the mesh: 0 inside, else the distance to the mesh's boundary (its quads split
