@@ -20,7 +20,8 @@
 //   4. optimize_hex_mesh() (mesher/hex_optimize.h) with the input's SurfaceProjector: the quad surface being
 //      our own construction, its nodes slide on the input (tether a quarter edge), only the landmark nodes
 //      (MandibleQuadReport::landmark_vertices) stay fixed; then the worst-element pass (threshold 0.3, 10
-//      scaled-Jacobian sweeps).
+//      scaled-Jacobian sweeps, two rounds) and the mean stage (10 sweeps raising the mean scaled Jacobian
+//      without lowering the worst).
 //   5. Quality and fidelity (measure_fidelity, mesher/grid_mesher.h) of the final mesh against the input.
 // Output: the mesh (vertices 0 .. quads' vertices - 1 are the boundary, in the quad surface's order) and a
 // report. Hexes left inverted are reported (MandibleSheetReport::inverted), not thrown: the caller decides.

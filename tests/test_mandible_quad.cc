@@ -304,9 +304,9 @@ TEST(MandibleQuadsCli, MeshSheetsFromTheGeneratedMandibleIsValid) {
                 .exit_code,
             0);
   const auto j = expect_valid_sheet_mesh(dir + "/m.stl", dir + "/m.yaml", dir);
-  // Measured: 2,625 hexes, scaled Jacobian min 0.588 and mean 0.881, Hausdorff 2.39 mm after sliding.
+  // Measured: 2,625 hexes, scaled Jacobian min 0.588 and mean 0.905, Hausdorff 2.40 mm after sliding.
   EXPECT_GT(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.5);
-  EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.87);
+  EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.895);
   EXPECT_LT(j["fidelity"]["hausdorff_mm"].get<double>(), 2.9);
 }
 
@@ -314,9 +314,9 @@ TEST(MandibleQuadsCli, MeshSheetsFromTheRealJawIsValid) {
   const std::string dir = test::temp_dir();
   const auto j = expect_valid_sheet_mesh(test::shared_data("jaw/jaw_smooth.stl"),
                                          test::shared_data("jaw/landmarks.yaml"), dir);
-  // Measured: 2,192 hexes, scaled Jacobian min 0.225 and mean 0.815, Hausdorff 3.29 mm after sliding.
-  EXPECT_GT(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.18);
-  EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.805);
+  // Measured: 2,192 hexes, scaled Jacobian min 0.230 and mean 0.854, Hausdorff 3.29 mm after sliding.
+  EXPECT_GT(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.2);
+  EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.845);
   EXPECT_LT(j["fidelity"]["hausdorff_mm"].get<double>(), 4.0);
 }
 
