@@ -126,8 +126,11 @@ void classify(Selection& s, const SurfaceProjector& surface) {
 // the pillow layer pulls below the surface) instead of vanishing from the core. Distances are computed for
 // the inside cells within a few cells of an outside cell when the margin is positive (deeper cells are far
 // enough by construction), and, when it is negative, for the outside cells whose centre lies within
-// -margin * h of a triangle's bounding box (the others cannot qualify).
-void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
+// -margin * h of a triangle's bounding box (the others cannot qualify). An outside cell whose centre lies
+// farther out than thick_margin * h (when thick_margin > margin) is kept only where the solid is thinner
+// than a cell: where a ball of diameter h touching the surface at the centre's closest point from inside
+// does not fit in the solid.
+void select_core(Selection& s, const SurfaceProjector& surface, double margin, double thick_margin) {
   const Grid& g = s.grid;
   const long nc = g.cells();
   s.score.assign(nc, std::numeric_limits<double>::quiet_NaN());
@@ -175,7 +178,15 @@ void select_core(Selection& s, const SurfaceProjector& surface, double margin) {
       s.score[c] = kInf;
       s.selected[c] = 1;
     } else {
-      s.selected[c] = cell_score(s, surface, c) >= margin * g.h;
+      const double score = cell_score(s, surface, c);
+      s.selected[c] = score >= margin * g.h;
+      if (s.selected[c] && score < thick_margin * g.h) {
+        int i, j, k;
+        g.ijk(c, i, j, k);
+        const SurfacePoint foot = surface.closest(g.centre(i, j, k));
+        const double r = 0.5 * g.h;
+        s.selected[c] = surface.distance(sub(foot.point, scale(foot.normal, r))) < 0.99 * r;
+      }
     }
   }
 }
@@ -322,9 +333,10 @@ void count_cells(Selection& s) {
   }
 }
 
-// The selection for cell size h, the grid shifted by `shift` cells along every axis.
+// The selection for cell size h, the grid shifted by `shift` cells along every axis (select_core's
+// margins).
 Selection build_selection(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, double h,
-                          double shift, double margin) {
+                          double shift, double margin, double thick_margin) {
   Selection s;
   s.grid.h = h;
   for (int a = 0; a < 3; ++a) {
@@ -334,7 +346,7 @@ Selection build_selection(const SurfaceProjector& surface, const Vec3& lo, const
     s.grid.origin[a] = 0.5 * (lo[a] + hi[a]) - (0.5 * s.grid.n[a] - shift) * h;
   }
   classify(s, surface);
-  select_core(s, surface, margin);
+  select_core(s, surface, margin, thick_margin);
   // Manifold repair first: a part that touches the rest only along an edge or at a vertex (a thin process
   // at this cell size) is then joined by a cell instead of being dropped as a separate component.
   make_manifold(s, surface);
@@ -601,8 +613,10 @@ struct GridAttempt {
   std::vector<Vec3> pillowed;  // the nodes before optimization
 };
 
+// `mean_thickness` is the solid's 2 V / A, which decides whether thick_margin applies at a cell size.
 GridAttempt run_grid_attempt(const SurfaceProjector& projector, const Vec3& lo, const Vec3& hi, double volume,
-                             const GridMeshOptions& options, const OptimizeOptions& optimize, double shift) {
+                             double mean_thickness, const GridMeshOptions& options,
+                             const OptimizeOptions& optimize, double shift) {
   const auto t_attempt = std::chrono::steady_clock::now();
   GridAttempt out;
   GridMeshReport& r = out.report;
@@ -615,7 +629,9 @@ GridAttempt run_grid_attempt(const SurfaceProjector& projector, const Vec3& lo, 
   double best_error = kInf;
   double prev_h = 0, prev_total = 0;
   for (int step = 0; step < 8; ++step) {
-    Selection s = build_selection(projector, lo, hi, h, shift, options.margin);
+    const double thick_margin =
+        options.thick_margin_cells * h <= mean_thickness ? options.thick_margin : options.margin;
+    Selection s = build_selection(projector, lo, hi, h, shift, options.margin, thick_margin);
     const double total = double(s.core_cells + s.boundary_quads);
     const double error = std::fabs(total - target) / target;
     if (s.core_cells > 0 && error < best_error) best_error = error, best = std::move(s);
@@ -663,6 +679,11 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   const double volume = enclosed_volume(surface);
   if (!(volume > 0))
     throw InputError("grid mesher: the surface encloses no volume (is it oriented outward?)");
+  double area = 0;
+  for (const auto& t : surface.triangles)
+    area += 0.5 * norm(cross(sub(surface.vertices[t[1]], surface.vertices[t[0]]),
+                             sub(surface.vertices[t[2]], surface.vertices[t[0]])));
+  const double mean_thickness = 2.0 * volume / area;
   Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
   for (const Vec3& p : surface.vertices)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
@@ -690,7 +711,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     const QuietThread quiet_thread(quiet);
     for (int a = next++; a < grids; a = next++) {
       try {
-        attempts[a] = run_grid_attempt(projector, lo, hi, volume, options, per_grid, shifts[a]);
+        attempts[a] =
+            run_grid_attempt(projector, lo, hi, volume, mean_thickness, options, per_grid, shifts[a]);
       } catch (...) {
         errors[a] = std::current_exception();
       }

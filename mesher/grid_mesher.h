@@ -11,8 +11,9 @@
 //      a few secant steps on the actual counts;
 //   2. core: the grid cells whose centre lies inside the surface at a distance of at least margin * h, or
 //      with the default negative margin outside at most -margin * h (cells that reach well into the solid,
-//      so that plates thinner than a cell, like the coronoid process, keep a sheet of cells); inside by
-//      crossing parity along grid columns, distances from the AABB tree. Cells are added until no two cells
+//      so that plates thinner than a cell, like the coronoid process, keep a sheet of cells; with fine cells
+//      only where the solid is thinner than a cell, elsewhere within thick_margin); inside by crossing
+//      parity along grid columns, distances from the AABB tree. Cells are added until no two cells
 //      share only an edge or a vertex and the core boundary is a 2-manifold (this also joins parts that
 //      touch the rest only along an edge), the largest face-connected component is kept and enclosed
 //      cavities are filled;
@@ -51,6 +52,12 @@ struct GridMeshOptions {
   // cells whose centre lies up to -margin * h outside (cells reaching into the solid), so that parts
   // thinner than a cell stay in the core.
   double margin = -0.4;
+  // With fine cells (the solid's mean thickness 2 V / A at least thick_margin_cells cells), an outside cell
+  // whose centre lies farther out than thick_margin * h is kept only where the solid is thinner than a
+  // cell: fewer cells reach out of the thicker parts, so their pillow hexes are thicker. Coarser grids use
+  // margin everywhere (with the solid 1 to 3 cells thick, every cell reaching into it counts).
+  double thick_margin = -0.2;
+  double thick_margin_cells = 3.0;
   // Grids tried, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3). The mesh with
   // the fewest inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
   int grids = 3;
