@@ -170,19 +170,27 @@ double worst_measure(const HexMesh& m) {
   return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
 }
 
-// The worst-element pass raises the worst hex of a condition-optimized mesh whose fixed boundary is sheared
-// (so the optimum is not a cube grid), and never lowers it; sliding nodes stay on the surface.
-TEST(HexOptimize, WorstElementPassRaisesTheWorstHex) {
+// A 5 x 5 x 5 grid with a perturbed interior and a boundary the cubes cannot fit (a shear that grows with
+// height and a bulge in x); *movable receives its interior nodes.
+HexMesh sheared_grid(std::vector<char>* movable) {
   HexMesh m = make_grid(5, 1.0);
   perturb_interior(m, 5.0, 0.3, 21);
-  // A shear that grows with height and a bulge in x: a boundary the cubes cannot fit.
   for (Vec3& p : m.vertices) {
     p[0] += 0.08 * p[2] * p[2];
     p[1] += 0.3 * std::sin(p[0]);
   }
-  std::vector<char> movable(m.vertices.size()), sliding;
   const std::vector<char> boundary = boundary_vertex_mask(m);
-  for (std::size_t v = 0; v < m.vertices.size(); ++v) movable[v] = !boundary[v];
+  movable->assign(m.vertices.size(), 0);
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) (*movable)[v] = !boundary[v];
+  return m;
+}
+
+// The worst-element pass raises the worst hex of a condition-optimized mesh whose fixed boundary is sheared
+// (so the optimum is not a cube grid), and never lowers it; sliding nodes stay on the surface.
+TEST(HexOptimize, WorstElementPassRaisesTheWorstHex) {
+  std::vector<char> movable, sliding;
+  HexMesh m = sheared_grid(&movable);
+  const std::vector<char> boundary = boundary_vertex_mask(m);
   optimize_condition(m, movable, sliding, nullptr, OptimizeOptions{});
   ASSERT_EQ(summarize_quality(m).inverted, 0);
   const double before = worst_measure(m);
@@ -215,15 +223,9 @@ TEST(HexOptimize, WorstElementPassRaisesTheWorstHex) {
 // pass, never lowers its smallest scaled Jacobian nor raises its largest condition number, and moves no
 // fixed node; optimize_hex_mesh runs it only when asked.
 TEST(HexOptimize, MeanStageRaisesTheMeanScaledJacobian) {
-  HexMesh m = make_grid(5, 1.0);
-  perturb_interior(m, 5.0, 0.3, 21);
-  for (Vec3& p : m.vertices) {
-    p[0] += 0.08 * p[2] * p[2];
-    p[1] += 0.3 * std::sin(p[0]);
-  }
-  std::vector<char> movable(m.vertices.size()), sliding;
+  std::vector<char> movable, sliding;
+  HexMesh m = sheared_grid(&movable);
   const std::vector<char> boundary = boundary_vertex_mask(m);
-  for (std::size_t v = 0; v < m.vertices.size(); ++v) movable[v] = !boundary[v];
   OptimizeOptions options;
   options.worst_element_threshold = 0.5;
   options.scaled_jacobian_sweeps = 3;
