@@ -86,7 +86,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core"
-      << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grid positions" : std::string())
+      << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string())
       << "\n\n";
   out << phase_table(r.optimize) << '\n';
   out << "optimizer: " << r.optimize.untangle_sweeps << " untangling sweeps, " << r.optimize.iterations

@@ -24,6 +24,8 @@
 //      worst-element pass (hexes with a scaled Jacobian or 3 / kappa below 0.5; both stages twice);
 //   5. steps 1-4 again on the grid shifted by half a cell, then by a quarter; the mesh with the fewest
 //      inverted hexes, then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept;
+//      where thick_margin applied and that measure stays below 0.3, the three grids again with the plain
+//      margin, the best of the six kept (attempts = 6);
 //   6. on the kept mesh only, improve_mean_jacobian raises the mean scaled Jacobian without lowering that
 //      measure (boundary nodes sliding within worst_element_reach of where the pillow layer put them).
 // Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
@@ -107,7 +109,7 @@ struct MeshFidelity {
 };
 
 struct GridMeshReport {
-  int attempts = 1;           // grids tried (GridMeshOptions::grids), the best one kept
+  int attempts = 1;           // grids tried (GridMeshOptions::grids, twice with the plain-margin retry)
   double cell_size = 0;       // h, mm (this and the fields below describe the kept grid)
   std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;
