@@ -633,55 +633,66 @@ bool meet_in_disk(const std::array<HexMesh, 2>& parts, const PrimalCycleSplit& s
   return common == disk;
 }
 
+// Where the inner copies of a pillow layer start (hex_pillow.h): a start for the embedding only.
+constexpr double kPillowInset = 0.4;
+
 // Steps 1 and 2 for `surface`, decomposing it along a primal cycle when the elimination is stuck (depth:
-// the nesting of the decomposition that made it). Adds the counts of eliminations, sheets and
-// decompositions to `counts`. The result's vertices 0..n-1 are the surface's.
-HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& options, int depth,
+// the nesting of the decomposition that made it; parts are decomposed again while it is below max_depth).
+// Splits whose parts mesh with less nesting come first: the search runs with the parts' nesting limited to
+// depth + 1, then depth + 2, ... max_depth. Adds the counts of eliminations, sheets and decompositions to
+// `counts`. The result's vertices 0..n-1 are the surface's.
+HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& options, int depth, int max_depth,
                       SheetMeshReport& counts) {
   EliminationScheme scheme;
   try {
     scheme = eliminate_chords(surface, options.elimination);
   } catch (const RunError& stuck) {
-    if (depth >= options.decomposition.max_depth) throw;
+    if (depth >= max_depth) throw;
     const int n = static_cast<int>(surface.vertices.size());
     HexMesh glued;
-    const DecompositionSearch search =
-        search_primal_cycle_splits(surface, options.decomposition, [&](const PrimalCycleSplit& split) {
-          std::array<HexMesh, 2> parts;
-          SheetMeshReport part_counts;
-          try {
-            for (int s = 0; s < 2; ++s)
-              parts[s] = sheet_complex(split.parts[s], options, depth + 1, part_counts);
-          } catch (const RunError&) {
-            return false;
+    DecompositionSearch search;
+    for (int limit = depth + 1; limit <= max_depth && !search.accepted; ++limit)
+      search = search_primal_cycle_splits(surface, options.decomposition, [&](const PrimalCycleSplit& split) {
+        std::array<HexMesh, 2> parts;
+        SheetMeshReport part_counts;
+        try {
+          for (int s = 0; s < 2; ++s)
+            parts[s] = sheet_complex(split.parts[s], options, depth + 1, limit, part_counts);
+        } catch (const RunError&) {
+          return false;
+        }
+        // A pillow layer under each part (its side's quads and the disk): no hex of the parts' complexes
+        // keeps a face on the boundary or on the disk, and the parts meet in the disk's quads only. Without
+        // it they may meet only in the disk: an edge of both between two disk vertices that is no disk edge
+        // (possible where the parts' elimination connected cycle vertices) would not be conforming.
+        if (options.decomposition.pillow_parts) {
+          for (int s = 0; s < 2; ++s) pillow_quad_boundary(parts[s], split.parts[s], kPillowInset);
+        } else if (!meet_in_disk(parts, split, n)) {
+          return false;
+        }
+        // The surface's vertices, the disk's, then the parts' interior vertices part by part.
+        glued.vertices = surface.vertices;
+        glued.vertices.insert(glued.vertices.end(), split.disk_positions.begin(), split.disk_positions.end());
+        for (int s = 0; s < 2; ++s) {
+          std::vector<int> id = split.ids[s];
+          const int k = static_cast<int>(id.size());
+          for (int v = k; v < static_cast<int>(parts[s].vertices.size()); ++v) {
+            id.push_back(static_cast<int>(glued.vertices.size()));
+            glued.vertices.push_back(parts[s].vertices[v]);
           }
-          // The parts may meet only in the disk: an edge of both between two disk vertices that is no disk
-          // edge (possible where the parts' elimination connected cycle vertices) would not be conforming.
-          if (!meet_in_disk(parts, split, n)) return false;
-          // The surface's vertices, the disk's, then the parts' interior vertices part by part.
-          glued.vertices = surface.vertices;
-          glued.vertices.insert(glued.vertices.end(), split.disk_positions.begin(),
-                                split.disk_positions.end());
-          for (int s = 0; s < 2; ++s) {
-            std::vector<int> id = split.ids[s];
-            const int k = static_cast<int>(id.size());
-            for (int v = k; v < static_cast<int>(parts[s].vertices.size()); ++v) {
-              id.push_back(static_cast<int>(glued.vertices.size()));
-              glued.vertices.push_back(parts[s].vertices[v]);
-            }
-            for (auto hex : parts[s].hexes) {
-              for (int& v : hex) v = id[v];
-              glued.hexes.push_back(hex);
-            }
+          for (auto hex : parts[s].hexes) {
+            for (int& v : hex) v = id[v];
+            glued.hexes.push_back(hex);
           }
-          counts.eliminations_single += part_counts.eliminations_single;
-          counts.eliminations_k_step += part_counts.eliminations_k_step;
-          counts.chords_eliminated += part_counts.chords_eliminated;
-          counts.external_sheets += part_counts.external_sheets;
-          counts.internal_sheets += part_counts.internal_sheets;
-          counts.decompositions += part_counts.decompositions + 1;
-          return true;
-        });
+        }
+        counts.eliminations_single += part_counts.eliminations_single;
+        counts.eliminations_k_step += part_counts.eliminations_k_step;
+        counts.chords_eliminated += part_counts.chords_eliminated;
+        counts.external_sheets += part_counts.external_sheets;
+        counts.internal_sheets += part_counts.internal_sheets;
+        counts.decompositions += part_counts.decompositions + 1;
+        return true;
+      });
     if (search.accepted) return glued;
     std::string message = stuck.what();
     const std::string advice = kStuckAdvice;
@@ -709,6 +720,33 @@ HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& option
   return mesh;
 }
 
+// The embedding keeps the boundary where it is. At a corner b of a quad (a, b, c, d) whose neighbours a and
+// c lie on one line with it, every hex on the quad has the corner Jacobian det(a - b, c - b, x - b) = 0,
+// whatever its fourth edge b -> x: no hex mesh with this boundary is valid. InputError naming the first such
+// corner and how many there are.
+void throw_on_collinear_corners(const QuadSurface& surface) {
+  int flat = 0;
+  std::string first;
+  for (std::size_t q = 0; q < surface.quads.size(); ++q)
+    for (int k = 0; k < 4; ++k) {
+      const Quad& quad = surface.quads[q];
+      const int a = quad[(k + 3) % 4], b = quad[k], c = quad[(k + 1) % 4];
+      const Vec3 u = vec3::sub(surface.vertices[a], surface.vertices[b]);
+      const Vec3 w = vec3::sub(surface.vertices[c], surface.vertices[b]);
+      if (vec3::norm(vec3::cross(u, w)) > 1e-12 * vec3::norm(u) * vec3::norm(w)) continue;
+      if (flat++ > 0) continue;
+      const std::string id_b = std::to_string(b);
+      first = "quad " + std::to_string(q) + " (vertices " + std::to_string(quad[0]) + ", " +
+              std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) +
+              ") has three collinear corners " + std::to_string(a) + ", " + id_b + ", " + std::to_string(c) +
+              ": every hex on it has a corner Jacobian of 0 at vertex " + id_b +
+              " whatever the interior, so no valid hex mesh has this boundary (fixed at the input); " +
+              "move vertex " + id_b + " off the line (make the quad convex)";
+    }
+  if (flat > 0)
+    throw InputError(first + (flat > 1 ? " (" + std::to_string(flat) + " such quad corners in all)" : ""));
+}
+
 }  // namespace
 
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
@@ -716,7 +754,8 @@ HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOpt
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   SheetMeshReport counts;
-  HexMesh mesh = sheet_complex(surface, options, 0, counts);
+  HexMesh mesh = sheet_complex(surface, options, 0, options.decomposition.max_depth, counts);
+  if (options.optimize) throw_on_collinear_corners(surface);
   const auto t1 = Clock::now();
   const int n = static_cast<int>(surface.vertices.size());
   OptimizeReport opt = embed(mesh, n, options);
@@ -725,7 +764,7 @@ HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOpt
   int pillow_hexes = 0;
   if (options.optimize && options.pillow_if_inverted && quality.inverted > 0) {
     HexMesh pillowed = mesh;
-    const int added = pillow_quad_boundary(pillowed, surface, 0.4);
+    const int added = pillow_quad_boundary(pillowed, surface, kPillowInset);
     OptimizeReport pillowed_opt = embed(pillowed, n, options);
     QualitySummary pillowed_quality = summarize_quality(pillowed);
     if (pillowed_quality.inverted < quality.inverted) {

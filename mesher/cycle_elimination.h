@@ -49,11 +49,15 @@
 // elimination of a surface gets stuck, the surface is split along a short even primal cycle spanned by a
 // quad disk into two balls (each side plus the disk); each part is meshed in the same way (elimination,
 // construction, and a nested decomposition up to DecompositionOptions::max_depth), the first split whose
-// two parts both mesh is taken, and the two complexes are glued along the disk (the same vertices and
-// quads, so the result is conforming; the disk's vertices are new interior vertices).
+// two parts both mesh with the least nesting is taken, each part gets a pillow layer under its quads
+// (DecompositionOptions::pillow_parts: its hexes then lie one layer inside and can move), and the two
+// complexes are glued along the disk (the same vertices and quads, so the result is conforming; the disk's
+// vertices are new interior vertices).
 // Failure: when no elimination is feasible before the cube, RunError naming the remaining chords and some of
 // their quads, suggesting --method grid; from mesh_by_cycle_elimination() only when no decomposition helps
-// either, saying how many cycles and splits were tried.
+// either, saying how many cycles and splits were tried. With the embedding (SheetMeshOptions::optimize,
+// the boundary fixed), InputError after the construction for a quad with three collinear corners: every
+// hex on it has a corner Jacobian of 0 there, so no valid mesh with that boundary exists.
 // Cost: per step, the chords and sides O(C F) for C chords and F quads, each feasibility test O(F log F);
 // kFewestHexes usually tests one candidate per step, the look-ahead orders up to all candidates of the next
 // step; the geometric order also measures the rail angles and the flatness of every candidate, O(C F) per
@@ -168,7 +172,8 @@ struct SheetMeshReport {
 };
 
 // Steps 1 to 3, with decomposition where the elimination is stuck. The counts of eliminations and sheets
-// add up over the parts of a decomposition.
+// add up over the parts of a decomposition. With options.optimize, InputError when a quad has three
+// collinear corners (no valid hex mesh has that boundary).
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
                                   SheetMeshReport* report = nullptr);
 

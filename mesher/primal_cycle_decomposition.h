@@ -39,6 +39,9 @@ struct DecompositionOptions {
   int max_cycle_length = 12;  // even cycles of length 4 .. this
   int max_splits = 64;        // usable splits handed to the caller at most
   int max_depth = 2;  // nested decompositions of a part (mesh_by_cycle_elimination); 0: never decompose
+  // mesh_by_cycle_elimination: a pillow layer under each part of a split (its side's quads and the disk),
+  // so that every hex of the parts' complexes lies one layer inside and can move in the embedding.
+  bool pillow_parts = true;
 };
 
 struct PrimalCycleSplit {

@@ -403,50 +403,101 @@ TEST(CycleElimination, DecompositionSplitsABlockAtAnEquatorWithAFan) {
   EXPECT_EQ(handed, 1);
 }
 
-// The 30-quad ball without an elimination scheme meshes through one decomposition in every order: an
-// 8-cycle with 15 quads on either side, spanned by a ladder of 3 quads, leaves two 18-quad parts that
-// eliminate (4 single eliminations in all). The result must be conforming (extract_boundary() throws
-// otherwise), bounded by exactly the input, and every hex must have 8 distinct vertices. The 10 hexes have
-// no interior vertex, so the embedding cannot move anything: 6 are inverted on both geometries. The pillow
-// rescue gives them interior vertices: on the convex version 2 stay inverted (40 hexes); on
-// no_scheme_surface(), whose collapsed quads have three collinear corners (a corner Jacobian of 0 on the
-// boundary whatever the interior), it does not help and the 10 hexes are kept. The command reports the
-// inverted hexes and refuses to write without --allow-invalid.
+// The 30-quad ball without an elimination scheme (convex version) meshes through one decomposition in every
+// order: an 8-cycle with 15 quads on either side, spanned by a ladder of 3 quads, leaves two 18-quad parts
+// that eliminate (4 single eliminations, 10 hexes in all), and each part gets a pillow layer under its 18
+// quads (36 hexes). The result must be conforming (extract_boundary() throws otherwise), bounded by exactly
+// the input, every hex must have 8 distinct vertices and at most one face on the boundary, and no hex may be
+// inverted without the pillow rescue. Without the part pillows the 10 hexes have no interior vertex: 6
+// inverted, and the pillow rescue leaves 2 of its 40.
 TEST(CycleElimination, StuckSurfaceMeshesByDecomposition) {
-  const std::array<QuadSurface, 2> surfaces{test::no_scheme_surface(), test::no_scheme_convex_surface()};
-  for (int convex = 0; convex < 2; ++convex) {
-    const QuadSurface& s = surfaces[convex];
-    for (EliminationOrder order :
-         {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
-      SCOPED_TRACE(elimination_order_name(order));
-      SheetMeshOptions options;
-      options.elimination.order = order;
-      SheetMeshReport r;
-      const HexMesh mesh = mesh_by_cycle_elimination(s, options, &r);
-      expect_boundary_equals_input(mesh, s);
-      const int pillow = convex ? 30 : 0;
-      ASSERT_EQ(mesh.hexes.size(), 10u + pillow);
-      for (const auto& hex : mesh.hexes) {
-        auto sorted = hex;
-        std::sort(sorted.begin(), sorted.end());
-        EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
-      }
-      EXPECT_EQ(r.decompositions, 1);
-      EXPECT_EQ(r.hexes, 10 + pillow);
-      EXPECT_EQ(r.pillow_hexes, pillow);
-      EXPECT_EQ(r.interior_vertices, convex ? 32 : 0);  // a copy of every boundary vertex
-      EXPECT_EQ(r.eliminations, 4);
-      EXPECT_EQ(r.eliminations_single, 4);
-      EXPECT_EQ(r.chords_eliminated, 4);
-      EXPECT_EQ(r.external_sheets + r.internal_sheets, 4);
-      EXPECT_EQ(r.inverted_without_pillow, 6);
-      EXPECT_EQ(r.quality.inverted, convex ? 2 : 6);
+  const QuadSurface s = test::no_scheme_convex_surface();
+  const int n = static_cast<int>(s.vertices.size());
+  for (EliminationOrder order :
+       {EliminationOrder::kFewestHexes, EliminationOrder::kLookAhead, EliminationOrder::kGeometric}) {
+    SCOPED_TRACE(elimination_order_name(order));
+    SheetMeshOptions options;
+    options.elimination.order = order;
+    SheetMeshReport r;
+    const HexMesh mesh = mesh_by_cycle_elimination(s, options, &r);
+    expect_boundary_equals_input(mesh, s);
+    ASSERT_EQ(mesh.hexes.size(), 46u);
+    for (const auto& hex : mesh.hexes) {
+      auto sorted = hex;
+      std::sort(sorted.begin(), sorted.end());
+      EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+      EXPECT_LE(std::count_if(hex.begin(), hex.end(), [n](int v) { return v < n; }), 4);
     }
+    EXPECT_EQ(r.decompositions, 1);
+    EXPECT_EQ(r.hexes, 46);
+    EXPECT_EQ(r.interior_vertices, 40);  // a copy of every part's vertex (32 + 8 on the cycle)
+    EXPECT_EQ(r.eliminations, 4);
+    EXPECT_EQ(r.eliminations_single, 4);
+    EXPECT_EQ(r.chords_eliminated, 4);
+    EXPECT_EQ(r.external_sheets + r.internal_sheets, 4);
+    EXPECT_EQ(r.inverted_without_pillow, 0);
+    EXPECT_EQ(r.pillow_hexes, 0);
+    EXPECT_EQ(r.quality.inverted, 0);
+    EXPECT_GT(r.quality.scaled_jacobian.min, 0.15);
   }
+  SheetMeshOptions unpillowed;
+  unpillowed.decomposition.pillow_parts = false;
+  SheetMeshReport r;
+  const HexMesh mesh = mesh_by_cycle_elimination(s, unpillowed, &r);
+  expect_boundary_equals_input(mesh, s);
+  EXPECT_EQ(r.decompositions, 1);
+  EXPECT_EQ(r.inverted_without_pillow, 6);
+  EXPECT_EQ(r.hexes, 40);
+  EXPECT_EQ(r.pillow_hexes, 30);
+  EXPECT_EQ(r.quality.inverted, 2);
   // A surface with a scheme is never decomposed.
   SheetMeshReport block;
   mesh_by_cycle_elimination(test::block_surface(3, 2, 2), {}, &block);
   EXPECT_EQ(block.decompositions, 0);
+}
+
+// no_scheme_surface() has 4 quads with three collinear corners (the collapsed diagonals' ends): a hex on such
+// a quad has a corner Jacobian of 0 there whatever the interior, so no hex mesh with this boundary is valid.
+// With the boundary fixed (optimize), mesh_by_cycle_elimination says so; the decomposition's complex,
+// embedded with the boundary fixed, has exactly those 4 hexes degenerate (Jacobian 0, not negative) and the
+// other 42 valid.
+TEST(CycleElimination, CollinearQuadCornersAreAnInputError) {
+  const QuadSurface s = test::no_scheme_surface();
+  try {
+    mesh_by_cycle_elimination(s, {});
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("has three collinear corners"), std::string::npos) << m;
+    EXPECT_NE(m.find("corner Jacobian of 0"), std::string::npos) << m;
+    EXPECT_NE(m.find("no valid hex mesh has this boundary"), std::string::npos) << m;
+    EXPECT_NE(m.find("(4 such quad corners in all)"), std::string::npos) << m;
+  }
+  SheetMeshOptions unembedded;
+  unembedded.optimize = false;
+  HexMesh mesh = mesh_by_cycle_elimination(s, unembedded);
+  ASSERT_EQ(mesh.hexes.size(), 46u);
+  const int n = static_cast<int>(s.vertices.size());
+  std::vector<char> fixed(mesh.vertices.size(), 0);
+  std::fill(fixed.begin(), fixed.begin() + n, 1);
+  optimize_hex_mesh(mesh, nullptr, fixed);
+  const HexQualityField field = compute_hex_quality(mesh);
+  const QualitySummary quality = summarize_quality(mesh, field);
+  ASSERT_EQ(quality.inverted, 4);
+  for (int h : quality.inverted_hexes) {
+    EXPECT_EQ(field.jacobian[h], 0.0);
+    // The hex's boundary face (corners 4..7, the pillow hex's quad) has three collinear corners.
+    const auto& hex = mesh.hexes[h];
+    bool collinear = false;
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 a = mesh.vertices[hex[4 + (k + 3) % 4]], b = mesh.vertices[hex[4 + k]],
+                 c = mesh.vertices[hex[4 + (k + 1) % 4]];
+      const Vec3 u{a[0] - b[0], a[1] - b[1], a[2] - b[2]}, w{c[0] - b[0], c[1] - b[1], c[2] - b[2]};
+      collinear = collinear ||
+                  (u[1] * w[2] == u[2] * w[1] && u[2] * w[0] == u[0] * w[2] && u[0] * w[1] == u[1] * w[0]);
+    }
+    EXPECT_TRUE(collinear) << "hex " << h;
+  }
 }
 
 // Where decomposition fails as well (here: only 4-cycles allowed, and every 4-cycle of this ball bounds a
@@ -575,25 +626,27 @@ TEST(MeshSheetsCli, WritesTheMeshAndRejectsBadSurfaces) {
   EXPECT_NE(bad.err.find("not a ball: genus 1"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/t.vtu"));
 
-  // The surface without a scheme meshes by decomposition; 6 of its 10 hexes stay inverted, so the mesh is
-  // written only with --allow-invalid.
-  write_quad_obj(dir + "/stuck.obj", test::no_scheme_surface());
-  const auto stuck = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/stuck.obj",
-                                        "--order", "look-ahead", "-o", dir + "/s.vtu"});
-  EXPECT_EQ(stuck.exit_code, 1);
-  EXPECT_NE(stuck.out.find("1 decompositions, 10 hexes"), std::string::npos) << stuck.out;
-  EXPECT_NE(stuck.err.find("6 hexes stay inverted"), std::string::npos) << stuck.err;
-  EXPECT_FALSE(std::filesystem::exists(dir + "/s.vtu"));
+  // The surface without a scheme meshes by decomposition into a valid mesh; with collinear quad corners
+  // (no valid mesh exists) it is an input error that says so, and nothing is written even with
+  // --allow-invalid.
+  write_quad_obj(dir + "/stuck.obj", test::no_scheme_convex_surface());
   const auto split = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/stuck.obj",
-                                        "-o", dir + "/s.vtu", "--allow-invalid", "--json"});
+                                        "--order", "look-ahead", "-o", dir + "/s.vtu", "--json"});
   ASSERT_EQ(split.exit_code, 0) << split.err;
   const auto js = nlohmann::json::parse(split.out);
   EXPECT_EQ(js["decompositions"], 1);
-  EXPECT_EQ(js["hexes"], 10);
+  EXPECT_EQ(js["hexes"], 46);
   EXPECT_EQ(js["eliminations_single"], 4);
-  EXPECT_EQ(js["quality"]["inverted"], 6);
+  EXPECT_EQ(js["quality"]["inverted"], 0);
   const HexMesh written = read_vtu(dir + "/s.vtu");
-  EXPECT_EQ(written.hexes.size(), 10u);
+  EXPECT_EQ(written.hexes.size(), 46u);
+  write_quad_obj(dir + "/flat.obj", test::no_scheme_surface());
+  const auto flat = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/flat.obj",
+                                       "-o", dir + "/f.vtu", "--allow-invalid"});
+  EXPECT_EQ(flat.exit_code, 2);
+  EXPECT_NE(flat.err.find("three collinear corners"), std::string::npos) << flat.err;
+  EXPECT_NE(flat.err.find("no valid hex mesh has this boundary"), std::string::npos) << flat.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/f.vtu"));
   EXPECT_EQ(j["decompositions"], 0);
 }
 
