@@ -11,10 +11,12 @@
 // written unless --allow-invalid asks for it. With --landmarks, the surface regions that the cell size
 // cannot resolve are named by their nearest landmark and muscle insertion.
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "app/commands.h"
@@ -22,11 +24,13 @@
 #include "app/mesh_sheets_surface.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/boundary_fit.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
 #include "mesher/landmarks.h"
 #include "mesher/surface_check.h"
+#include "mesher/surface_projector.h"
 #include "mesher/units.h"
 #include "postprocess/quality_json.h"
 
@@ -45,6 +49,7 @@ struct MeshOptions {
   std::string units = "mm";
   bool json = false;
   bool allow_invalid = false;
+  bool fit_volume = false;
   double margin = GridMeshOptions{}.margin;
   std::string quad_surface;         // --method sheets
   std::string order = "geometric";  // --method sheets
@@ -78,7 +83,19 @@ std::string phase_table(const OptimizeReport& r) {
   return out.str();
 }
 
-std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r) {
+nlohmann::json volume_fit_json(const BoundaryFitReport* fit) {
+  if (fit == nullptr) return nullptr;
+  return {{"boundary_nodes", fit->boundary_nodes},
+          {"moved_nodes", fit->moved_nodes},
+          {"limited_moves", fit->limited_moves},
+          {"mean_gap_before_mm", fit->mean_gap_before},
+          {"mean_gap_after_mm", fit->mean_gap_after},
+          {"max_node_offset_mm", fit->max_node_offset},
+          {"seconds", fit->seconds}};
+}
+
+std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
+                        const BoundaryFitReport* fit) {
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
   out << "Meshed " << o.surface << " (grid + pillow): " << mesh.hexes.size() << " hexes (" << r.core_hexes
@@ -101,6 +118,13 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << " mm\n";
   out << "volume: mesh " << fmt("%.1f", f.mesh_volume) << " mm^3, surface " << fmt("%.1f", f.surface_volume)
       << " mm^3, difference " << fmt("%+.2f", 100.0 * f.volume_difference) << " %\n";
+  if (fit != nullptr)
+    out << "volume fit: " << fit->moved_nodes << " of " << fit->boundary_nodes
+        << " boundary nodes moved along their normals (" << fit->limited_moves
+        << " moves shortened to keep the hexes' quality); mean signed distance of the boundary to the "
+           "surface "
+        << fmt("%+.3f", fit->mean_gap_before) << " -> " << fmt("%+.3f", fit->mean_gap_after)
+        << " mm, largest node offset " << fmt("%.2f", fit->max_node_offset) << " mm\n";
   if (!f.unresolved.empty()) {
     out << "not resolved at this size (" << f.unresolved.size() << " regions):\n";
     const std::size_t shown = std::min<std::size_t>(f.unresolved.size(), 10);
@@ -111,7 +135,8 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   return out.str();
 }
 
-nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r, bool written) {
+nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
+                           const BoundaryFitReport* fit, bool written) {
   nlohmann::json j;
   j["surface"] = o.surface;
   j["method"] = o.method;
@@ -141,12 +166,17 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
                   {"fidelity", r.seconds_fidelity},
                   {"total", r.seconds_total}};
   j["fidelity"] = fidelity_to_json(r.fidelity);
+  j["volume_fit"] = volume_fit_json(fit);
   j["inverted"] = r.optimize.inverted;
   j["output"] = written ? nlohmann::json(o.output) : nlohmann::json();
   return j;
 }
 
 void run_mesh(const MeshOptions& o) {
+  if (o.fit_volume && o.method != "grid")
+    throw InputError(
+        "--fit-volume moves the boundary nodes of a --method grid mesh; --method sheets keeps its quad "
+        "surface (or the input's) as the boundary: drop --fit-volume, or use --method grid");
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
     return run_mesh_sheets_surface({{o.surface, o.landmarks, o.units, 0, o.output, o.json, o.refine},
                                     o.target,
@@ -172,7 +202,17 @@ void run_mesh(const MeshOptions& o) {
   options.target_hexes = o.target;
   options.margin = o.margin;
   GridMeshReport report;
-  const HexMesh mesh = grid_mesh(surface, options, &report);
+  HexMesh mesh = grid_mesh(surface, options, &report);
+  std::optional<BoundaryFitReport> fit;
+  if (o.fit_volume) {
+    const SurfaceProjector projector(surface);
+    fit = fit_boundary_to_volume(mesh, projector, {});
+    report.optimize.phases.push_back({"volume fit", summarize_quality(mesh), fit->seconds});
+    const auto t0 = std::chrono::steady_clock::now();
+    report.fidelity = measure_fidelity(mesh, projector);
+    report.seconds_fidelity = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    report.seconds_total += fit->seconds + report.seconds_fidelity;
+  }
   if (landmarks) name_unresolved_parts(*landmarks, report.fidelity.unresolved);
   const QualitySummary& final_quality = report.optimize.phases.back().quality;
   const bool valid = final_quality.inverted == 0;
@@ -180,9 +220,9 @@ void run_mesh(const MeshOptions& o) {
   if (write) write_vtu(o.output, mesh);
 
   if (o.json)
-    std::cout << report_json(o, mesh, report, write).dump(2) << '\n';
+    std::cout << report_json(o, mesh, report, fit ? &*fit : nullptr, write).dump(2) << '\n';
   else if (!is_quiet())
-    std::cout << report_text(o, mesh, report);
+    std::cout << report_text(o, mesh, report, fit ? &*fit : nullptr);
   if (!valid) {
     const std::string list = hex_list_text(mesh, final_quality.inverted_hexes);
     if (o.allow_invalid) {
@@ -228,6 +268,10 @@ void add_mesh_command(CLI::App& app) {
          "the core)")
       ->check(CLI::Range(-0.8, 2.0))
       ->default_val(o->margin);
+  cmd->add_flag("--fit-volume", o->fit_volume,
+                "--method grid: move the boundary nodes off the surface along their normals until the "
+                "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "
+                "quarter edge from the surface)");
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");
   add_refine_options(*cmd, o->refine);

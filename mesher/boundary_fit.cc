@@ -1,0 +1,156 @@
+#include "mesher/boundary_fit.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "common/progress.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_quality_kernel.h"
+#include "mesher/vec3.h"
+
+namespace hexbite {
+
+using vec3::add;
+using vec3::cross;
+using vec3::norm;
+using vec3::scale;
+using vec3::sub;
+
+namespace {
+
+// Signed distance of p to the surface, positive outside.
+double signed_distance(const SurfaceProjector& surface, const Vec3& p) {
+  const double d = surface.distance(p);
+  return surface.inside(p) ? -d : d;
+}
+
+// Bilinear point of quad corners x at (u, v) in [0, 1]^2 and the area element there.
+Vec3 bilinear(const std::array<Vec3, 4>& x, double u, double v, double* area) {
+  const Vec3 du = add(scale(sub(x[1], x[0]), 1 - v), scale(sub(x[2], x[3]), v));
+  const Vec3 dv = add(scale(sub(x[3], x[0]), 1 - u), scale(sub(x[2], x[1]), u));
+  *area = norm(cross(du, dv));
+  return add(add(scale(x[0], (1 - u) * (1 - v)), scale(x[1], u * (1 - v))),
+             add(scale(x[2], u * v), scale(x[3], (1 - u) * v)));
+}
+
+HexQuality quality_of(const HexMesh& mesh, int e) {
+  std::array<Vec3, 8> x;
+  for (int i = 0; i < 8; ++i) x[i] = mesh.vertices[mesh.hexes[e][i]];
+  return hex_quality(x);
+}
+
+}  // namespace
+
+BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& surface,
+                                         const std::vector<char>& fixed, const BoundaryFitOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  BoundaryFitReport report;
+  const HexBoundary boundary = extract_boundary(mesh);
+  const std::vector<int>& ids = boundary.boundary_vertices;
+  const auto& quads = boundary.surface.quads;
+  const std::size_t nb = ids.size();
+  report.boundary_nodes = static_cast<int>(nb);
+
+  std::vector<std::vector<int>> hexes_of(mesh.vertices.size());
+  for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+    for (int v : mesh.hexes[e]) hexes_of[v].push_back(static_cast<int>(e));
+  std::vector<HexQuality> quality(mesh.hexes.size());
+  double sj_min = 1.0, kappa_max = 3.0;
+  for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
+    quality[e] = quality_of(mesh, static_cast<int>(e));
+    sj_min = std::min(sj_min, quality[e].scaled_jacobian);
+    kappa_max = std::max(kappa_max, quality[e].condition);
+    if (quality[e].inverted) return report;  // only valid meshes are fitted
+  }
+  // Mean boundary edge length per node, for the offset limit.
+  std::vector<double> edge(nb, 0.0);
+  std::vector<int> edge_count(nb, 0);
+  for (const auto& q : quads)
+    for (int k = 0; k < 4; ++k) {
+      const double len = norm(sub(mesh.vertices[ids[q[k]]], mesh.vertices[ids[q[(k + 1) % 4]]]));
+      for (int w : {q[k], q[(k + 1) % 4]}) {
+        edge[w] += len;
+        ++edge_count[w];
+      }
+    }
+  for (std::size_t i = 0; i < nb; ++i) edge[i] /= std::max(1, edge_count[i]);
+
+  Progress progress("volume fit");
+  constexpr std::array<double, 3> kSamples = {1.0 / 6, 0.5, 5.0 / 6};  // midpoint rule, 3 x 3
+  for (int round = 0; round <= options.rounds; ++round) {
+    std::vector<double> gap_sum(nb, 0.0), area_sum(nb, 0.0);
+    std::vector<Vec3> normal(nb, Vec3{0, 0, 0});
+    double total_gap = 0.0, total_area = 0.0;
+    for (const auto& q : quads) {
+      std::array<Vec3, 4> x;
+      for (int k = 0; k < 4; ++k) x[k] = mesh.vertices[ids[q[k]]];
+      double gap = 0.0, area = 0.0;
+      for (double u : kSamples)
+        for (double v : kSamples) {
+          double da = 0.0;
+          const Vec3 p = bilinear(x, u, v, &da);
+          gap += da * signed_distance(surface, p);
+          area += da;
+        }
+      const Vec3 n = cross(sub(x[2], x[0]), sub(x[3], x[1]));  // twice the area vector
+      for (int k = 0; k < 4; ++k) {
+        gap_sum[q[k]] += gap;
+        area_sum[q[k]] += area;
+        normal[q[k]] = add(normal[q[k]], n);
+      }
+      total_gap += gap;
+      total_area += area;
+    }
+    const double mean_gap = total_area > 0 ? total_gap / total_area : 0.0;
+    if (round == 0) report.mean_gap_before = mean_gap;
+    report.mean_gap_after = mean_gap;
+    if (round == options.rounds) break;
+    progress.update(double(round) / options.rounds, "round " + std::to_string(round + 1));
+
+    report.moved_nodes = 0;
+    for (std::size_t i = 0; i < nb; ++i) {
+      const int v = ids[i];
+      if ((!fixed.empty() && fixed[v]) || area_sum[i] <= 0.0) continue;
+      const double len = norm(normal[i]);
+      if (len <= 0.0) continue;
+      const Vec3 n = scale(normal[i], 1.0 / len);
+      const Vec3 old = mesh.vertices[v];
+      // Move out by the mean gap of the node's quads, but not farther than the limit from the surface.
+      double step = -gap_sum[i] / area_sum[i];
+      const double limit = options.max_offset * edge[i];
+      const double now = signed_distance(surface, old);
+      step = std::clamp(now + step, -limit, limit) - now;
+      bool accepted = false;
+      for (int halving = 0; halving < 4 && !accepted; ++halving, step *= 0.5) {
+        mesh.vertices[v] = add(old, scale(n, step));
+        accepted = true;
+        for (int e : hexes_of[v]) {
+          const HexQuality q = quality_of(mesh, e);
+          if (q.scaled_jacobian < std::min(quality[e].scaled_jacobian, sj_min) ||
+              q.scaled_jacobian < quality[e].scaled_jacobian - options.max_scaled_jacobian_drop ||
+              q.condition > std::max(quality[e].condition, kappa_max)) {
+            accepted = false;
+            break;
+          }
+        }
+        if (!accepted) ++report.limited_moves;
+      }
+      if (!accepted) {
+        mesh.vertices[v] = old;
+        continue;
+      }
+      for (int e : hexes_of[v]) quality[e] = quality_of(mesh, e);
+      ++report.moved_nodes;
+    }
+  }
+  progress.finish();
+  for (int v : ids)
+    report.max_node_offset = std::max(report.max_node_offset, surface.distance(mesh.vertices[v]));
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+}  // namespace hexbite
