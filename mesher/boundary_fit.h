@@ -14,10 +14,13 @@
 // around the node keeps its scaled Jacobian above the smaller of its value and the mesh's minimum, loses at
 // most max_scaled_jacobian_drop of it per move, and keeps its condition number below the larger of its value
 // and the mesh's maximum: validity and the worst element never get worse. Fixed nodes do not move; a mesh
-// with an inverted hex is returned unchanged. Written by hand: CGAL's mesh processing smooths and fairs
-// surfaces, it does not fit a hex mesh's boundary to the volume of another surface. Cost: per round, 9
-// closest-point and inside queries per boundary quad (AABB tree) and a quality check of the hexes around each
-// moved node.
+// with an inverted hex is returned unchanged.
+//
+// Cost: per round, 9 closest-point and inside queries per boundary quad (AABB tree) and a quality check of
+// the hexes around each moved node.
+//
+// Written by hand: CGAL's mesh processing smooths and fairs surfaces; it does not fit a hex mesh's boundary
+// to the volume of another surface.
 #pragma once
 
 #include <vector>
