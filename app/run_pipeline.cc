@@ -9,7 +9,9 @@
 
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/boundary_fit.h"
 #include "mesher/ct_surface.h"
+#include "mesher/grid_mesher.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
@@ -66,6 +68,18 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   options.target_hexes = s.mesh.target_hexes;
   GridMeshReport report;
   HexMesh mesh = grid_mesh(geometry.surface, options, &report);
+  if (s.mesh.fit_volume && report.optimize.inverted == 0) {
+    const SurfaceProjector projector(geometry.surface);
+    const BoundaryFitReport fit = fit_boundary_to_volume(mesh, projector, {});
+    report.fidelity = measure_fidelity(mesh, projector);
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "mesh.fit_volume: %d of %d boundary nodes moved, up to %.2f mm off the surface; volume "
+                  "%+.2f %%",
+                  fit.moved_nodes, fit.boundary_nodes, fit.max_node_offset,
+                  100.0 * report.fidelity.volume_difference);
+    info(line);
+  }
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
   for (const UnresolvedPart& part : report.fidelity.unresolved) info("not resolved: " + part.what);
@@ -350,11 +364,19 @@ RunResult run_pipeline(Scenario scenario, int levels) {
     Progress progress("refine level " + std::to_string(level));
     const auto t = std::chrono::steady_clock::now();
     RefineReport report;
+    const std::size_t coarse_nodes = result.levels.back().mesh.vertices.size();
     HexMesh fine = refine_to_surface(result.levels.back().mesh, projector.get(), RefineOptions{}, &report);
     if (report.after.inverted > 0)
       throw RunError("refinement level " + std::to_string(level) + " left " +
                      std::to_string(report.after.inverted) +
                      " inverted hexes; run with fewer validation levels (--levels) or another target_hexes");
+    if (scenario.mesh.fit_volume) {
+      // The coarse nodes keep their (fitted) positions, as the refinement keeps them; the new boundary
+      // nodes, which it put on the surface, are fitted around them.
+      std::vector<char> fixed(fine.vertices.size(), 0);
+      std::fill(fixed.begin(), fixed.begin() + static_cast<std::ptrdiff_t>(coarse_nodes), 1);
+      fit_boundary_to_volume(fine, *projector, fixed);
+    }
     const double seconds = seconds_since(t);
     result.levels.push_back(prepare_level(scenario, level, std::move(fine)));
     result.levels.back().seconds_mesh = seconds;

@@ -390,7 +390,7 @@ LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, cons
 
 MeshSettings parse_mesh(const Value& v) {
   const Map map(v, {"method", "target_hexes", "validation_levels", "refine_at_bite", "refine_radius_mm",
-                    "refine_levels"});
+                    "refine_levels", "fit_volume"});
   MeshSettings m;
   if (auto x = map.find("method")) {
     m.method = to_choice<MeshMethod>(*x, {{"grid", MeshMethod::kGrid}, {"sheets", MeshMethod::kSheets}});
@@ -432,6 +432,13 @@ MeshSettings parse_mesh(const Value& v) {
       fail(x->at, "mesh.refine_levels is " + std::to_string(m.refine_levels) + " but must be from 1 to " +
                       std::to_string(kMaxRefineLevels) +
                       " (rings of quads around the bite point); the default is 3");
+  }
+  if (auto x = map.find("fit_volume")) {
+    m.fit_volume = to_bool(*x);
+    if (m.fit_volume && m.method != MeshMethod::kGrid)
+      fail(x->at,
+           "mesh.fit_volume moves the boundary nodes of the grid mesher, but mesh.method is sheets, whose "
+           "boundary is its quad surface; write method: grid in mesh, or remove fit_volume");
   }
   return m;
 }

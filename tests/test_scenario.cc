@@ -273,6 +273,15 @@ TEST(ScenarioErrors, UnknownKeySuggestsTheClosest) {
                   "did you mean 'dentate'?");
 }
 
+// mesh.fit_volume (the grid mesher's boundary moved off the surface until the volume matches) is read for
+// method grid and refused, at its line, for method sheets, whose boundary is its quad surface.
+TEST(ScenarioErrors, FitVolumeIsForTheGridMethodOnly) {
+  EXPECT_FALSE(load_scenario(write_scenario(kValid)).mesh.fit_volume);
+  EXPECT_TRUE(load_scenario(write_scenario(kValid + "mesh: {fit_volume: true}\n")).mesh.fit_volume);
+  EXPECT_ERROR_AT(error_of(kValid + "mesh:\n  method: sheets\n  fit_volume: true\n"), 13,
+                  "mesh.fit_volume moves the boundary nodes of the grid mesher, but mesh.method is sheets");
+}
+
 TEST(ScenarioErrors, RepeatedKey) {
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    activation: 0.6")), 7,
