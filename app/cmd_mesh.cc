@@ -1,5 +1,5 @@
 // hexbite mesh SURFACE --method grid --target-hexes N -o mesh.vtu [--units mm|cm|m] [--landmarks L.yaml]
-// [--json] [--allow-invalid]
+// [--fit-volume] [--json] [--allow-invalid]
 // hexbite mesh SURFACE --method sheets [--landmarks L.yaml] --target-hexes N -o mesh.vtu [--refine-at
 // X,Y,Z|LANDMARK [--refine-radius MM] [--refine-levels K]] (a mandible:
 // app/mesh_sheets_surface.h) or hexbite mesh --method sheets --quad-surface Q.obj -o mesh.vtu
@@ -9,7 +9,8 @@
 // the quality per phase (like the seed paper's Table 1), the timings and the geometric fidelity. A mesh
 // that stays inverted is a failed run (exit 1, naming the inverted hexes with their centroids) and is not
 // written unless --allow-invalid asks for it. With --landmarks, the surface regions that the cell size
-// cannot resolve are named by their nearest landmark and muscle insertion.
+// cannot resolve are named by their nearest landmark and muscle insertion. --fit-volume then moves the
+// boundary nodes off the surface until the mesh holds the surface's volume (mesher/boundary_fit.h).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -83,17 +84,6 @@ std::string phase_table(const OptimizeReport& r) {
   return out.str();
 }
 
-nlohmann::json volume_fit_json(const BoundaryFitReport* fit) {
-  if (fit == nullptr) return nullptr;
-  return {{"boundary_nodes", fit->boundary_nodes},
-          {"moved_nodes", fit->moved_nodes},
-          {"limited_moves", fit->limited_moves},
-          {"mean_gap_before_mm", fit->mean_gap_before},
-          {"mean_gap_after_mm", fit->mean_gap_after},
-          {"max_node_offset_mm", fit->max_node_offset},
-          {"seconds", fit->seconds}};
-}
-
 std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
                         const BoundaryFitReport* fit) {
   std::ostringstream out;
@@ -118,13 +108,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << " mm\n";
   out << "volume: mesh " << fmt("%.1f", f.mesh_volume) << " mm^3, surface " << fmt("%.1f", f.surface_volume)
       << " mm^3, difference " << fmt("%+.2f", 100.0 * f.volume_difference) << " %\n";
-  if (fit != nullptr)
-    out << "volume fit: " << fit->moved_nodes << " of " << fit->boundary_nodes
-        << " boundary nodes moved along their normals (" << fit->limited_moves
-        << " moves shortened to keep the hexes' quality); mean signed distance of the boundary to the "
-           "surface "
-        << fmt("%+.3f", fit->mean_gap_before) << " -> " << fmt("%+.3f", fit->mean_gap_after)
-        << " mm, largest node offset " << fmt("%.2f", fit->max_node_offset) << " mm\n";
+  if (fit != nullptr) out << "volume fit: " << describe(*fit) << '\n';
   if (!f.unresolved.empty()) {
     out << "not resolved at this size (" << f.unresolved.size() << " regions):\n";
     const std::size_t shown = std::min<std::size_t>(f.unresolved.size(), 10);
@@ -166,7 +150,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
                   {"fidelity", r.seconds_fidelity},
                   {"total", r.seconds_total}};
   j["fidelity"] = fidelity_to_json(r.fidelity);
-  j["volume_fit"] = volume_fit_json(fit);
+  j["volume_fit"] = fit ? volume_fit_to_json(*fit) : nlohmann::json();
   j["inverted"] = r.optimize.inverted;
   j["output"] = written ? nlohmann::json(o.output) : nlohmann::json();
   return j;

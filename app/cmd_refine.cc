@@ -1,4 +1,5 @@
-// hexbite refine MESH.vtu [--surface SURFACE] -o fine.vtu [--units mm|cm|m] [--levels N] [--json]
+// hexbite refine MESH.vtu [--surface SURFACE [--fit-volume]] -o fine.vtu [--units mm|cm|m] [--levels N]
+// [--json]
 //
 // Splits every hex into 8 (every boundary quad into 4), puts the new boundary nodes onto the surface when one
 // is given and re-optimizes where that made the quality worse; prints the quality before and after each step
@@ -6,15 +7,18 @@
 // compared node by node. A refined mesh with inverted hexes is a failed run (exit 1, naming them with their
 // centroids) and is not written.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "app/commands.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/boundary_fit.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
@@ -36,6 +40,7 @@ struct RefineCliOptions {
   std::string output;
   std::string units = "mm";
   int levels = 1;
+  bool fit_volume = false;
   bool json = false;
 };
 
@@ -54,7 +59,7 @@ std::string quality_row(const std::string& stage, const QualitySummary& q, doubl
   return line;
 }
 
-std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
+std::string report_text(const RefineCliOptions& o, const RefineReport& r, const BoundaryFitReport* fit) {
   std::ostringstream out;
   out << "Refined " << o.mesh << ": " << o.levels << (o.levels == 1 ? " level, " : " levels, ")
       << r.before.hexes << " -> " << r.after.hexes << " hexes, " << r.before.nodes << " -> " << r.after.nodes
@@ -95,6 +100,7 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
              "surface "
              "there\n";
   }
+  if (fit != nullptr) out << "volume fit (input nodes kept): " << describe(*fit) << '\n';
   double split = 0, project = 0, optimize = 0;
   for (const RefineLevelReport& l : r.levels) {
     split += l.seconds_split;
@@ -107,7 +113,8 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
   return out.str();
 }
 
-nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, bool written) {
+nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, const BoundaryFitReport* fit,
+                           bool written) {
   nlohmann::json j;
   j["mesh"] = o.mesh;
   j["surface"] = o.surface.empty() ? nlohmann::json() : nlohmann::json(o.surface);
@@ -141,12 +148,15 @@ nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, boo
     levels.push_back(level);
   }
   j["level_reports"] = levels;
+  j["volume_fit"] = fit ? volume_fit_to_json(*fit) : nlohmann::json();
   j["seconds_total"] = r.seconds_total;
   j["output"] = written ? nlohmann::json(o.output) : nlohmann::json();
   return j;
 }
 
 void run_refine(const RefineCliOptions& o) {
+  if (o.fit_volume && o.surface.empty())
+    throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
   const HexMesh coarse = read_vtu(o.mesh);
   const long long refined = static_cast<long long>(coarse.hexes.size()) << (3 * o.levels);
   if (refined > kMaxRefinedHexes)
@@ -161,14 +171,23 @@ void run_refine(const RefineCliOptions& o) {
   RefineOptions options;
   options.levels = o.levels;
   RefineReport report;
-  const HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
+  HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
   const bool valid = report.after.inverted == 0;
+  std::optional<BoundaryFitReport> fit;
+  if (o.fit_volume && valid) {
+    // The input's nodes keep their places (as the refinement keeps them); the new boundary nodes, which it
+    // put on the surface, are fitted around them.
+    std::vector<char> fixed(fine.vertices.size(), 0);
+    std::fill(fixed.begin(), fixed.begin() + static_cast<std::ptrdiff_t>(coarse.vertices.size()), 1);
+    fit = fit_boundary_to_volume(fine, *projector, fixed);
+    report.after = summarize_quality(fine);
+  }
   if (valid) write_vtu(o.output, fine);
 
   if (o.json)
-    std::cout << report_json(o, report, valid).dump(2) << '\n';
+    std::cout << report_json(o, report, fit ? &*fit : nullptr, valid).dump(2) << '\n';
   else if (!is_quiet())
-    std::cout << report_text(o, report);
+    std::cout << report_text(o, report, fit ? &*fit : nullptr);
   if (!valid) {
     std::string cause;
     if (report.before.inverted > 0)
@@ -197,6 +216,9 @@ void add_refine_command(CLI::App& app) {
       "onto it. Without it the refinement is purely parametric");
   cmd->add_option("-o,--output", o->output, "Refined mesh (.vtu)")->required();
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
+  cmd->add_flag("--fit-volume", o->fit_volume,
+                "After the refinement, move the new boundary nodes off the --surface until the boundary "
+                "quads straddle it (for a mesh made with hexbite mesh --fit-volume; the input's nodes stay)");
   cmd->add_option("--levels", o->levels, "Number of refinement levels (each multiplies the hexes by 8)")
       ->check(CLI::Range(1, 4))
       ->default_val(1);

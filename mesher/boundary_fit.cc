@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "common/progress.h"
@@ -151,6 +152,17 @@ BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& 
     report.max_node_offset = std::max(report.max_node_offset, surface.distance(mesh.vertices[v]));
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
+}
+
+std::string describe(const BoundaryFitReport& fit) {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "%d of %d boundary nodes moved along their normals (%d moves shortened to keep the hexes' "
+                "quality); mean signed distance of the boundary to the surface %+.3f -> %+.3f mm, largest "
+                "node offset %.2f mm",
+                fit.moved_nodes, fit.boundary_nodes, fit.limited_moves, fit.mean_gap_before,
+                fit.mean_gap_after, fit.max_node_offset);
+  return line;
 }
 
 }  // namespace hexbite

@@ -23,6 +23,7 @@
 // to the volume of another surface.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "mesher/hex_mesh.h"
@@ -49,5 +50,8 @@ struct BoundaryFitReport {
 BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& surface,
                                          const std::vector<char>& fixed,
                                          const BoundaryFitOptions& options = {});
+
+// One line for the text reports: "2016 of 2144 boundary nodes moved along their normals (...)".
+std::string describe(const BoundaryFitReport& fit);
 
 }  // namespace hexbite

@@ -76,4 +76,14 @@ nlohmann::json fidelity_to_json(const MeshFidelity& f) {
           {"unresolved", unresolved}};
 }
 
+nlohmann::json volume_fit_to_json(const BoundaryFitReport& fit) {
+  return {{"boundary_nodes", fit.boundary_nodes},
+          {"moved_nodes", fit.moved_nodes},
+          {"limited_moves", fit.limited_moves},
+          {"mean_gap_before_mm", fit.mean_gap_before},
+          {"mean_gap_after_mm", fit.mean_gap_after},
+          {"max_node_offset_mm", fit.max_node_offset},
+          {"seconds", fit.seconds}};
+}
+
 }  // namespace hexbite

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesher/boundary_fit.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_quality.h"
 
@@ -26,5 +27,10 @@ nlohmann::json quality_to_json(const QualitySummary& summary, double volume_mm3)
 // surface_volume_mm3, volume_difference, and unresolved: [{location, extent_mm, samples, near [{name,
 // distance_mm}], what}].
 nlohmann::json fidelity_to_json(const MeshFidelity& fidelity);
+
+// A volume fit (mesher/boundary_fit.h), as `hexbite mesh --json` and `hexbite refine --json` print it under
+// `volume_fit`: boundary_nodes, moved_nodes, limited_moves, mean_gap_before_mm, mean_gap_after_mm,
+// max_node_offset_mm, seconds.
+nlohmann::json volume_fit_to_json(const BoundaryFitReport& fit);
 
 }  // namespace hexbite
