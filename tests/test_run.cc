@@ -384,17 +384,31 @@ TEST(RunScenario, UnknownKeyIsRefused) {
   expect_refused(kSmall + "solvr: {degree: 1}\n", "did you mean 'solver'?");
 }
 
+// kSmall as it is, run once for the tests that compare a variant with it.
+const json& small_run() {
+  static const json result = [] {
+    const std::string dir = test::temp_dir();
+    test::write_file(dir + "/small.yaml", kSmall);
+    return run_scenario(dir + "/small.yaml", dir + "/small");
+  }();
+  return result;
+}
+
+// kSmall with `mesh_keys` (e.g. "method: sheets, ") put at the front of its mesh map, run.
+json run_small_with(const std::string& mesh_keys) {
+  const std::string dir = test::temp_dir();
+  std::string text = kSmall;
+  text.replace(text.find("target_hexes"), 0, mesh_keys);
+  test::write_file(dir + "/variant.yaml", text);
+  return run_scenario(dir + "/variant.yaml", dir + "/variant");
+}
+
 // `mesh: {method: sheets}` on the built-in mandible (its own landmarks place the template): the sheet
 // mesher's mesh keeps the patches, solves in equilibrium and bites like the grid mesher's mesh of the same
 // scenario.
 TEST(RunScenario, SheetsMethodBitesLikeTheGridMethod) {
-  const std::string dir = test::temp_dir();
-  std::string text = kSmall;
-  text.replace(text.find("target_hexes"), 0, "method: sheets, ");
-  test::write_file(dir + "/sheets.yaml", text);
-  test::write_file(dir + "/grid.yaml", kSmall);
-  const json sheets = run_scenario(dir + "/sheets.yaml", dir + "/sheets");
-  const json grid = run_scenario(dir + "/grid.yaml", dir + "/grid");
+  const json sheets = run_small_with("method: sheets, ");
+  const json& grid = small_run();
   ASSERT_TRUE(sheets.is_object() && grid.is_object());
   expect_contract(sheets, 1);
   EXPECT_EQ(sheets["mesh_method"], "sheets");
@@ -412,13 +426,8 @@ TEST(RunScenario, SheetsMethodBitesLikeTheGridMethod) {
 // `mesh: {fit_volume: true}`: the grid mesh's boundary nodes move off the surface until the mesh holds the
 // bone's volume (the plain mesh lacks 2-3 % of it at 4,000 hexes); the bite barely changes.
 TEST(RunScenario, FitVolumeMatchesTheBonesVolume) {
-  const std::string dir = test::temp_dir();
-  std::string text = kSmall;
-  text.replace(text.find("target_hexes"), 0, "fit_volume: true, ");
-  test::write_file(dir + "/fit.yaml", text);
-  test::write_file(dir + "/plain.yaml", kSmall);
-  const json fit = run_scenario(dir + "/fit.yaml", dir + "/fit");
-  const json plain = run_scenario(dir + "/plain.yaml", dir + "/plain");
+  const json fit = run_small_with("fit_volume: true, ");
+  const json& plain = small_run();
   ASSERT_TRUE(fit.is_object() && plain.is_object());
   expect_contract(fit, 1);
   EXPECT_EQ(fit["mesh"]["quality"]["inverted"].get<int>(), 0);
