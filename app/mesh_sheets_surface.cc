@@ -52,6 +52,10 @@ nlohmann::json quad_json(const MandibleQuadReport& r, const QuadSurfaceReport& c
           {"worst_surface_point", r.worst_surface_point},
           {"mean_edge_mm", r.mean_edge_mm},
           {"folded_quads", r.folded_quads},
+          {"fidelity_rings",
+           {{"rounds", r.fidelity_rounds},
+            {"undone_rounds", r.fidelity_undone_rounds},
+            {"quads_added", r.fidelity_quads_added}}},
           {"seconds", r.seconds}};
 }
 
@@ -79,6 +83,17 @@ std::string quad_text(const std::string& surface, const MandibleQuadReport& r,
       r.max_vertex_distance_mm, r.quads_to_surface_mm, r.surface_to_quads_mm, r.hausdorff_mm, r.folded_quads,
       r.seconds);
   out << line;
+  if (r.fidelity_rounds > 0) {
+    std::snprintf(line, sizeof line,
+                  "fidelity rings: %d rounds, +%d quads around the regions still farther than %.1f mm\n",
+                  r.fidelity_rounds, r.fidelity_quads_added, MandibleQuadOptions{}.snap_threshold_mm);
+    out << line;
+  } else if (r.fidelity_undone_rounds > 0) {
+    std::snprintf(line, sizeof line,
+                  "fidelity rings: %d rounds undone (they did not bring the quads within %.1f mm)\n",
+                  r.fidelity_undone_rounds, MandibleQuadOptions{}.snap_threshold_mm);
+    out << line;
+  }
   std::snprintf(line, sizeof line,
                 "farthest: quads from the surface at (%.1f, %.1f, %.1f) mm, surface from the quads at (%.1f, "
                 "%.1f, %.1f) mm\n",

@@ -96,9 +96,12 @@ HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* land
   // Step 2. Cycle elimination keeps the quad vertices' ids, so the landmark vertices stay valid.
   SheetMeshOptions options;
   options.elimination.order = o.order;
-  // The refinement's ring chords first: their collapse gives back the unrefined quads, whose elimination
-  // then runs as without refinement, and the rings become pillow sheets under the patch.
+  // The ring chords first, the bite-point refinement's and then those of the placement's fidelity
+  // refinement (latest first): their collapse gives back the unrefined quads, whose elimination then runs
+  // as without refinement, and the rings become pillow sheets under their patches.
   options.elimination.first_rungs = report.refinement.ring_rungs;
+  options.elimination.first_rungs.insert(options.elimination.first_rungs.end(),
+                                         report.quad.ring_rungs.begin(), report.quad.ring_rungs.end());
   options.optimize = false;
   SheetMeshReport& sheets = report.sheets;
   HexMesh mesh;

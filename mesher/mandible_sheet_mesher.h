@@ -11,8 +11,9 @@
 //      quads_for_target_hexes(target_hexes) quads, optionally refined around points (the bite point) by
 //      refine_quads_locally() (mesher/quad_local_refinement.h), then check_quad_surface()
 //      (mesher/quad_check.h).
-//   2. Cycle elimination (mesher/cycle_elimination.h) in the given order; the sheet mesher only smooths the
-//      interior (its own optimizer would hold the whole boundary fixed).
+//   2. Cycle elimination (mesher/cycle_elimination.h) in the given order, the ring chords of the bite-point
+//      refinement and of the placement's fidelity refinement (MandibleQuadReport::ring_rungs) first; the
+//      sheet mesher only smooths the interior (its own optimizer would hold the whole boundary fixed).
 //   3. A pillow layer under the quad surface: every quad vertex gets an inner copy, which takes its place in
 //      the hexes, and every quad a hex between it and the copies of its corners (copies start 40 % of the way
 //      from the vertex to the mean centroid of its hexes). The boundary stays the quad surface; no hex keeps

@@ -6,12 +6,14 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/mandible_quad_template.h"
 #include "mesher/quad_check.h"
+#include "mesher/quad_local_refinement.h"
 #include "mesher/surface_projector.h"
 #include "mesher/thin_plate_spline.h"
 #include "mesher/vec3.h"
@@ -778,6 +780,147 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
   }
 }
 
+// What step 9 measures of a placed surface: the far points (input vertices farther than threshold_mm from
+// the quads, and the closest surface points of quad sample points (5 x 5 per quad, as step 10) farther
+// than that from the input, each with its distance; farthest first), the Hausdorff distance and the
+// centres of the folded quads (as step 10 counts them).
+struct FarPoints {
+  std::vector<std::pair<double, Vec3>> far;  // (-distance, point)
+  double hausdorff = 0;
+  std::vector<Vec3> folded;
+  // The largest distance of the far points within `radius` of p (0 when there is none).
+  double near(const Vec3& p, double radius) const {
+    double d = 0;
+    for (const auto& [negative_distance, q] : far)
+      if (norm(sub(q, p)) <= radius) d = std::max(d, -negative_distance);
+    return d;
+  }
+};
+
+FarPoints measure_far(const QuadSurface& fine, const PlacementSurface& s, double threshold_mm) {
+  FarPoints r;
+  const SurfaceProjector quad_projector(fan_triangles(fine));
+  for (const Vec3& v : s.surface.vertices) {
+    const double d = quad_projector.distance(v);
+    r.hausdorff = std::max(r.hausdorff, d);
+    if (d > threshold_mm) r.far.push_back({-d, v});
+  }
+  for (const auto& quad : fine.quads) {
+    for (int j = 0; j <= 4; ++j)
+      for (int i = 0; i <= 4; ++i) {
+        const SurfacePoint sp = s.projector.closest(bilinear(fine, quad, i / 4.0, j / 4.0));
+        r.hausdorff = std::max(r.hausdorff, sp.distance);
+        if (sp.distance > threshold_mm) r.far.push_back({-sp.distance, sp.point});
+      }
+    for (int k = 0; k < 4; ++k) {
+      const Vec3& p = fine.vertices[quad[k]];
+      const Vec3 n =
+          cross(sub(fine.vertices[quad[(k + 1) % 4]], p), sub(fine.vertices[quad[(k + 3) % 4]], p));
+      if (dot(n, s.projector.closest(p).normal) <= 0) {
+        r.folded.push_back(bilinear(fine, quad, 0.5, 0.5));
+        break;
+      }
+    }
+  }
+  std::sort(r.far.begin(), r.far.end(), [](const auto& x, const auto& y) {
+    return std::tie(x.first, x.second) < std::tie(y.first, y.second);
+  });
+  return r;
+}
+
+// Fidelity refinement (step 9). Each round: the far points within fidelity_band_mm of the current
+// Hausdorff distance, thinned so that no two lie within fidelity_join_edges mean edges, are the centres of
+// one refine_quads_locally() call (mesher/quad_local_refinement.h: one level, radius fidelity_radius_edges
+// mean edges; the fixed nodes, landmark and snapped ones, stay); the refined surface is relaxed on the
+// moved and new nodes (fidelity_relax_sweeps, as step 6), untangled (step 7) and snapped (step 8). The
+// centres where a quad folded within radius + 1 edge, or where the far points within that reach did not
+// get nearer, are dropped and the round is redone from the surface before it (up to fidelity_passes
+// times); a round whose centres all stay is kept when it lowers the Hausdorff distance without more folded
+// quads, else the refinement stops. The rungs of kept rings go to report->ring_rungs, latest first.
+void refine_for_fidelity(QuadSurface& fine, const PlacementSurface& s, std::vector<char>& fixed,
+                         std::vector<Vec3>* surface_normal, const MandibleQuadOptions& o,
+                         MandibleQuadReport* report) {
+  FarPoints current = measure_far(fine, s, o.snap_threshold_mm);
+  if (current.hausdorff > o.max_hausdorff_mm) return;  // not a mandible: step 10 rejects it
+  const int quads_before = static_cast<int>(fine.quads.size());
+  const QuadSurface fine_before = fine;
+  const std::vector<char> fixed_before = fixed;
+  const std::vector<Vec3> normal_before = *surface_normal;
+  for (int round = 0; round < o.fidelity_rounds && !current.far.empty(); ++round) {
+    const QuadEdges edges = build_quad_edges(fine.quads);
+    double edge = 0;
+    for (const auto& e : edges.edges) edge += norm(sub(fine.vertices[e[1]], fine.vertices[e[0]]));
+    edge /= edges.edges.size();
+    LocalRefinementOptions refinement;
+    for (const auto& [negative_distance, p] : current.far)
+      if (-negative_distance >= current.hausdorff - o.fidelity_band_mm &&
+          std::none_of(refinement.points.begin(), refinement.points.end(),
+                       [&](const Vec3& c) { return norm(sub(p, c)) <= o.fidelity_join_edges * edge; }))
+        refinement.points.push_back(p);
+    refinement.radius_mm = std::clamp(o.fidelity_radius_edges * edge, kMinRefineRadiusMm, kMaxRefineRadiusMm);
+    refinement.levels = 1;
+    const double reach = refinement.radius_mm + edge;
+    std::vector<int> held;
+    for (std::size_t v = 0; v < fixed.size(); ++v)
+      if (fixed[v]) held.push_back(static_cast<int>(v));
+    bool kept_round = false;
+    for (int pass = 0; pass < o.fidelity_passes && !refinement.points.empty(); ++pass) {
+      LocalRefinementReport refined;
+      QuadSurface trial;
+      try {
+        trial = refine_quads_locally(fine, s.projector, held, refinement, &refined);
+      } catch (const InputError&) {
+        break;  // the patches would cover the whole surface (a very coarse target): no ring
+      }
+      std::vector<char> trial_fixed = fixed, frozen(trial.vertices.size(), 0);
+      for (std::size_t v = 0; v < fine.vertices.size(); ++v)
+        frozen[v] = fixed[v] || fine.vertices[v] == trial.vertices[v];
+      trial_fixed.resize(trial.vertices.size(), 0);
+      std::vector<Vec3> trial_normal(trial.vertices.size());
+      for (std::size_t v = 0; v < trial.vertices.size(); ++v)
+        trial_normal[v] = s.projector.closest(trial.vertices[v]).normal;
+      relax(trial, s, frozen, o.fidelity_relax_sweeps, &trial_normal);
+      unfold(trial, s, trial_fixed, o.unfold_sweeps, &trial_normal);
+      snap_features(trial, s, trial_fixed, o.snap_rounds, o.snap_threshold_mm, &trial_normal);
+      const FarPoints next = measure_far(trial, s, o.snap_threshold_mm);
+      std::vector<Vec3> kept;
+      for (const Vec3& p : refinement.points)
+        if (std::none_of(next.folded.begin(), next.folded.end(),
+                         [&](const Vec3& f) { return norm(sub(f, p)) <= reach; }) &&
+            next.near(p, reach) < current.near(p, reach))
+          kept.push_back(p);
+      if (kept.size() < refinement.points.size()) {
+        refinement.points = kept;
+        continue;
+      }
+      if (next.hausdorff < current.hausdorff - 1e-6 && next.folded.size() <= current.folded.size()) {
+        fine = std::move(trial);
+        fixed = std::move(trial_fixed);
+        *surface_normal = std::move(trial_normal);
+        report->ring_rungs.insert(report->ring_rungs.begin(), refined.ring_rungs.begin(),
+                                  refined.ring_rungs.end());
+        current = next;
+        ++report->fidelity_rounds;
+        kept_round = true;
+      }
+      break;
+    }
+    if (!kept_round) break;
+  }
+  // Rings that do not bring the quads within snap_threshold_mm are undone: on the real jaw they gained
+  // 0.2 mm (landmarks, 1.66 -> 1.48 mm) at the cost of the hex mesh's mean (0.854 -> 0.847), and 0.4 mm
+  // (1.42 -> 1.003 mm) with a mesh boundary slid 6.95 mm from the input instead of 3.69 mm.
+  if (current.hausdorff > o.snap_threshold_mm && report->fidelity_rounds > 0) {
+    fine = fine_before;
+    fixed = fixed_before;
+    *surface_normal = normal_before;
+    report->ring_rungs.clear();
+    report->fidelity_undone_rounds = report->fidelity_rounds;
+    report->fidelity_rounds = 0;
+  }
+  report->fidelity_quads_added = static_cast<int>(fine.quads.size()) - quads_before;
+}
+
 std::string point_text(const Vec3& p) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
@@ -881,9 +1024,13 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   relax(fine, target, fixed, options.relax_sweeps, &surface_normal);
   unfold(fine, target, fixed, options.unfold_sweeps, &surface_normal);
   snap_features(fine, target, fixed, options.snap_rounds, options.snap_threshold_mm, &surface_normal);
-  progress.update(0.9, "relaxed");
+  progress.update(0.8, "relaxed");
 
-  // 9. Fidelity.
+  // 9. Fidelity refinement: one ring of quads around the regions still far from the quads, then snapping.
+  refine_for_fidelity(fine, target, fixed, &surface_normal, options, &report);
+  progress.update(0.9, "refined for fidelity");
+
+  // 10. Fidelity.
   const QuadEdges fine_edges = build_quad_edges(fine.quads);
   double edge_sum = 0;
   for (const auto& e : fine_edges.edges) edge_sum += norm(sub(fine.vertices[e[1]], fine.vertices[e[0]]));

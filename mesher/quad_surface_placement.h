@@ -56,24 +56,35 @@
 //      points to the input) and keeps the smallest corner scaled Jacobian of the node's quads (sine of the
 //      corner angle, signed by the input normal) at least at 0.3 or at what it was; snapped nodes stay
 //      fixed. Up to snap_rounds rounds, each re-measuring the distances.
-//   9. Fidelity. Vertex distance to the input, quad-to-surface distance sampled on each bilinear quad, and
+//   9. Fidelity refinement. Where the input is still farther than snap_threshold_mm from the quads (or the
+//      quads from it) within fidelity_band_mm of the largest such distance, one ring of quads is added by
+//      nested surface pillowing around those points (refine_quads_locally, mesher/quad_local_refinement.h:
+//      one level, a radius of 3/4 of the mean edge; existing vertex ids keep their meaning), its nodes
+//      relaxed (step 6), untangled (step 7) and snapped (step 8). Points near which a quad folded or the
+//      distance did not fall are dropped and the round redone; a round is kept only when it lowers the
+//      Hausdorff distance without more folded quads. Up to fidelity_rounds rounds (rings may nest); when
+//      they do not bring the quads within snap_threshold_mm, all of them are undone. The
+//      ring chords' rungs are reported (MandibleQuadReport::ring_rungs) so that the sheet mesher
+//      eliminates them first.
+//  10. Fidelity. Vertex distance to the input, quad-to-surface distance sampled on each bilinear quad, and
 //      surface-to-quads distance of every input vertex (CGAL AABB trees, mesher/surface_projector.h); folded
 //      quads (a corner normal against the surface normal).
-// Limitations (measured, docs/mandible_quads.md): at 1,300 quads the Hausdorff distance is 1.1 mm on the
-// built-in mandible and 1.4 to 1.7 mm on the real jaw (1 mm is the goal; the farthest points are on the
-// condyle heads and necks and the real jaw's coronoid tips, incisal edges and molar crowns, finer than the
-// 3.6 mm quads, where a snapped node would bend a quad corner below 0.3), and at 3,000
+// Limitations (measured, docs/mandible_quads.md): at 1,300 quads the Hausdorff distance is 0.99 to 1.0 mm
+// on the built-in mandible and 1.0 to 1.5 mm on the real jaw (1 mm is the goal; with its landmarks the
+// real jaw's farthest points are a molar crown and the condyle tops, where no ring helps), and at 3,000
 // quads a few quads still fold (3) and the distance is 3.3 to 6.6 mm (gaps on the lingual side of the body
 // that the snapping does not close). Failure: InputError when a landmark file lacks the points the template
 // needs (naming the file and the missing names), when the surface is not mandible-like (its Hausdorff
 // distance to the placed template exceeds 10 mm, naming where), or when the target is out of range. Cost: O(T
 // log T) for T input triangles plus O((Q + V) sweeps) for Q quads and V input vertices (the Lloyd
 // assignment), plus about a thousand closest-point queries per node of a folded quad and untangling sweep,
-// plus per snapping round O(V log Q + Q) closest-point queries and local checks of the far vertices; 1.0
-// to 2.5 s for 50,000 triangles and 1,300 quads, measured while other builds shared the 2-core machine.
+// plus per snapping round O(V log Q + Q) closest-point queries and local checks of the far vertices, and
+// per fidelity pass one relaxation, untangling and snapping more; 1.5 to 6 s for 50,000 triangles and
+// 1,300 quads, measured while other builds shared the 2-core machine.
 // Deterministic (single-threaded, fixed orders).
 #pragma once
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,7 +105,14 @@ struct MandibleQuadOptions {
   double extreme_smoothing_mm = 20.0;
   int snap_rounds = 8;             // step 8; 0 turns feature snapping off
   double snap_threshold_mm = 1.0;  // input vertices farther than this from the quads pull a node
-  double max_hausdorff_mm = 10.0;  // above this the surface is not taken for a mandible
+  // Step 9, fidelity refinement (measured on the built-in mandible and the real jaw, docs/mandible_quads.md):
+  int fidelity_rounds = 6;              // 0 turns it off
+  double fidelity_band_mm = 0.1;        // far points within this of the Hausdorff distance get a ring
+  double fidelity_join_edges = 0.5;     // at most one centre within this many mean edges
+  double fidelity_radius_edges = 0.75;  // patch radius in mean edges
+  int fidelity_relax_sweeps = 20;       // step 6 on the moved and new nodes
+  int fidelity_passes = 3;              // tries per round, each without the centres that did not help
+  double max_hausdorff_mm = 10.0;       // above this the surface is not taken for a mandible
 };
 
 struct MandibleQuadReport {
@@ -119,6 +137,13 @@ struct MandibleQuadReport {
   // Quads with a corner whose normal (cross product of its two edges) points against the input surface's
   // normal there: folded or twisted quads, which no valid hex mesh can have as boundary faces.
   int folded_quads = 0;
+  // Step 9: rounds kept, quads added, and the rungs of the ring chords added (latest round first), which
+  // the sheet mesher eliminates first (EliminationOptions::first_rungs) so that its elimination stays that
+  // of the surface before step 9.
+  int fidelity_rounds = 0;
+  int fidelity_undone_rounds = 0;  // rounds undone because they did not reach snap_threshold_mm
+  int fidelity_quads_added = 0;
+  std::vector<std::array<int, 2>> ring_rungs;
   double seconds = 0;
 };
 
