@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <numeric>
 #include <queue>
@@ -611,14 +612,20 @@ struct GridAttempt {
   HexMesh mesh;
   Selection selection;
   std::vector<Vec3> pillowed;  // the nodes before optimization
-  bool thick_margin = false;   // the selection used GridMeshOptions::thick_margin
+  bool fine = false;           // the cells are fine (GridMeshOptions::thick_margin_cells)
 };
 
-// `mean_thickness` is the solid's 2 V / A, which decides whether thick_margin applies at a cell size;
-// with thick_rule false it never does.
-GridAttempt run_grid_attempt(const SurfaceProjector& projector, const Vec3& lo, const Vec3& hi, double volume,
-                             double mean_thickness, const GridMeshOptions& options,
-                             const OptimizeOptions& optimize, double shift, bool thick_rule) {
+// How an attempt picks the core's margins at a trial cell size h. With coarse cells (the solid's mean
+// thickness 2 V / A below thick_margin_cells * h) both rules use GridMeshOptions::margin everywhere.
+enum class CoreRule {
+  kPlain,   // fine cells: GridMeshOptions::fine_margin everywhere
+  kThick,   // fine cells: margin where the solid is thinner than a cell, thick_margin elsewhere
+  kMargin,  // fine cells too: margin everywhere
+};
+
+// Steps 1 and 2 of one grid, shifted by `shift` cells: the cell size and the core (`mesh` holds the core).
+GridAttempt grid_core(const SurfaceProjector& projector, const Vec3& lo, const Vec3& hi, double volume,
+                      double mean_thickness, const GridMeshOptions& options, double shift, CoreRule rule) {
   const auto t_attempt = std::chrono::steady_clock::now();
   GridAttempt out;
   GridMeshReport& r = out.report;
@@ -631,15 +638,17 @@ GridAttempt run_grid_attempt(const SurfaceProjector& projector, const Vec3& lo, 
   double best_error = kInf;
   double prev_h = 0, prev_total = 0;
   for (int step = 0; step < 8; ++step) {
-    const bool thick = thick_rule && options.thick_margin_cells * h <= mean_thickness;
-    const double thick_margin = thick ? options.thick_margin : options.margin;
-    Selection s = build_selection(projector, lo, hi, h, shift, options.margin, thick_margin);
+    const bool fine = options.thick_margin_cells * h <= mean_thickness;
+    double margin = options.margin, thick_margin = options.margin;
+    if (fine && rule == CoreRule::kPlain) margin = thick_margin = options.fine_margin;
+    if (fine && rule == CoreRule::kThick) thick_margin = options.thick_margin;
+    Selection s = build_selection(projector, lo, hi, h, shift, margin, thick_margin);
     const double total = double(s.core_cells + s.boundary_quads);
     const double error = std::fabs(total - target) / target;
     if (s.core_cells > 0 && error < best_error) {
       best_error = error;
       best = std::move(s);
-      out.thick_margin = thick;
+      out.fine = fine;
     }
     progress.update(double(step + 1) / 8,
                     "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
@@ -664,16 +673,21 @@ GridAttempt run_grid_attempt(const SurfaceProjector& projector, const Vec3& lo, 
   out.mesh = core_mesh(best);
   r.core_hexes = int(out.mesh.hexes.size());
   r.seconds_core = seconds_since(t_attempt);
+  return out;
+}
 
+// Steps 3 and 4 of one grid: the pillow layer and the optimization.
+void pillow_and_optimize(GridAttempt& attempt, const SurfaceProjector& projector,
+                         const OptimizeOptions& optimize) {
+  GridMeshReport& r = attempt.report;
   auto t0 = std::chrono::steady_clock::now();
-  r.pillow_hexes = add_pillow_layer(out.mesh, projector, best.grid.h);
+  r.pillow_hexes = add_pillow_layer(attempt.mesh, projector, attempt.selection.grid.h);
   r.seconds_pillow = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  out.pillowed = out.mesh.vertices;
-  r.optimize = optimize_hex_mesh(out.mesh, &projector, {}, optimize);
+  attempt.pillowed = attempt.mesh.vertices;
+  r.optimize = optimize_hex_mesh(attempt.mesh, &projector, {}, optimize);
   r.seconds_optimize = seconds_since(t0);
-  return out;
 }
 
 HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
@@ -703,73 +717,116 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   auto worst_measure = [](const QualitySummary& q) {
     return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
   };
+  // With fine cells, between two grids whose worst-element measures are both at least mean_tie_break the
+  // higher mean (before the mean stage) wins: both minima meet the targets, the mean decides.
+  auto better = [&](const GridAttempt& x, const GridAttempt& y) {
+    const QualitySummary& q = x.report.optimize.phases.back().quality;
+    const QualitySummary& r = y.report.optimize.phases.back().quality;
+    if (q.inverted != r.inverted) return q.inverted < r.inverted;
+    const double wq = worst_measure(q), wr = worst_measure(r);
+    if (x.fine && y.fine && wq >= options.mean_tie_break && wr >= options.mean_tie_break)
+      return q.scaled_jacobian.mean > r.scaled_jacobian.mean;
+    return wq > wr;
+  };
   // The mean stage does not lower the worst-element measure that picks the grid, so it runs on the kept
   // grid only.
   OptimizeOptions per_grid = options.optimize;
   per_grid.mean_jacobian_sweeps = 0;
-  // The grids are independent: up to `threads` of them run at once (the calling thread shows progress,
-  // the others are quiet). Each attempt's result depends only on its shift and margin rule, and the choice
-  // below goes in attempt order, so the mesh does not depend on the number of threads.
-  auto run_grids = [&](bool thick_rule) {
-    std::vector<GridAttempt> attempts(grids);
-    std::vector<std::exception_ptr> errors(grids);
-    std::atomic<int> next{0};
-    auto work = [&](bool quiet) {
-      const QuietThread quiet_thread(quiet);
-      for (int a = next++; a < grids; a = next++) {
-        try {
-          attempts[a] = run_grid_attempt(projector, lo, hi, volume, mean_thickness, options, per_grid,
-                                         shifts[a], thick_rule);
-        } catch (...) {
-          errors[a] = std::current_exception();
-        }
-      }
-    };
-    const int threads = std::clamp(options.threads, 1, grids);
-    std::vector<std::thread> helpers;
-    for (int t = 1; t < threads; ++t) helpers.emplace_back(work, true);
-    work(false);
-    for (std::thread& t : helpers) t.join();
-    for (const std::exception_ptr& e : errors)
-      if (e) std::rethrow_exception(e);
-    return attempts;
+  // The attempts: with coarse cells the plain core on each grid. With fine cells the plain core
+  // (fine_margin, the cells whose centre lies inside) on the unshifted and the half-shifted grid, and the
+  // thick-margin core (thin plates keep their cells) on the half- and the quarter-shifted grid: the plain
+  // core gave the better means and minima on the built-in mandible, the thick margin the real jaw's better
+  // minima at 30,000-50,000 hexes and its coronoid tips, and which grid position wins varies with the size
+  // (docs/meshing.md); four attempts take two rounds in two threads, as three did. Attempts 0 and 1 are the
+  // same either way; attempt 0's core (the calling thread computes it first) decides whether the cells are
+  // fine.
+  struct Job {
+    double shift;
+    CoreRule rule;
   };
-
-  GridMeshReport report;
-  HexMesh mesh;
-  Selection kept;
-  std::vector<Vec3> kept_pillowed;  // the kept grid's nodes before optimization
-  bool have = false;
-  auto keep_best = [&](std::vector<GridAttempt>& attempts) {
-    for (GridAttempt& t : attempts) {
-      const QualitySummary& q = t.report.optimize.phases.back().quality;
-      const QualitySummary* kept_q = have ? &report.optimize.phases.back().quality : nullptr;
-      if (!kept_q || q.inverted < kept_q->inverted ||
-          (q.inverted == kept_q->inverted && worst_measure(q) > worst_measure(*kept_q))) {
-        report = std::move(t.report);
-        mesh = std::move(t.mesh);
-        kept = std::move(t.selection);
-        kept_pillowed = std::move(t.pillowed);
-        have = true;
-      }
+  Job jobs[4 + 3] = {{shifts[0], CoreRule::kPlain}, {shifts[1], CoreRule::kPlain}};
+  int job_count = 0;  // set with jobs[2] and jobs[3] once attempt 0's core is known
+  std::promise<void> jobs_known;
+  const std::shared_future<void> jobs_ready = jobs_known.get_future().share();
+  auto decide_jobs = [&](bool fine) {
+    job_count = std::min(grids, 2);
+    if (fine)
+      for (int a = 1; a < grids; ++a) jobs[job_count++] = {shifts[a], CoreRule::kThick};
+    else if (grids == 3)
+      jobs[job_count++] = {shifts[2], CoreRule::kPlain};
+    jobs_known.set_value();
+  };
+  std::vector<GridAttempt> attempts(4 + 3);
+  std::vector<std::exception_ptr> errors(4 + 3);
+  auto run_job = [&](int a) {
+    try {
+      if (a > 0)
+        attempts[a] =
+            grid_core(projector, lo, hi, volume, mean_thickness, options, jobs[a].shift, jobs[a].rule);
+      pillow_and_optimize(attempts[a], projector, per_grid);
+    } catch (...) {
+      errors[a] = std::current_exception();
     }
   };
-  std::vector<GridAttempt> attempts = run_grids(true);
-  const bool thick_used =
-      std::any_of(attempts.begin(), attempts.end(), [](const GridAttempt& t) { return t.thick_margin; });
-  keep_best(attempts);
-  report.attempts = grids;
-  // Where the thin-where-thick margin applied and the best grid still has a defect (a worst-element
-  // measure below 0.3), the grids with the plain margin may do better (which one wins depends on the size:
-  // the mandible at 25,000 hexes kept 3 hexes of SJ 0.11 with it and none below 0.67 without), so they are
-  // tried too and the best of the six kept. Not for a minimum that is merely short of 0.5 (the real jaw's
-  // coronoid tips, 0.41-0.44 at 20,000-45,000 hexes, either way), which would double the time for nothing.
-  constexpr double kDefect = 0.3;
-  if (thick_used && worst_measure(report.optimize.phases.back().quality) < kDefect) {
-    attempts = run_grids(false);
-    keep_best(attempts);
-    report.attempts = 2 * grids;
+  // The grids are independent: up to `threads` of them run at once (the calling thread shows progress,
+  // the others are quiet). Each attempt's result depends only on its shift and core rule, and the choice
+  // below goes in attempt order, so the mesh does not depend on the number of threads.
+  std::atomic<int> next{1};
+  auto work = [&](bool quiet) {
+    const QuietThread quiet_thread(quiet);
+    for (int a = next++;; a = next++) {
+      if (a >= 2) jobs_ready.wait();
+      if (a >= (a < 2 ? std::min(grids, 2) : job_count)) break;
+      run_job(a);
+    }
+  };
+  {
+    std::vector<std::thread> helpers;
+    for (int t = 1; t < std::clamp(options.threads, 1, 4); ++t) helpers.emplace_back(work, true);
+    try {
+      attempts[0] =
+          grid_core(projector, lo, hi, volume, mean_thickness, options, shifts[0], CoreRule::kPlain);
+      decide_jobs(attempts[0].fine);
+      run_job(0);
+    } catch (...) {
+      errors[0] = std::current_exception();
+      decide_jobs(false);
+    }
+    work(false);
+    for (std::thread& t : helpers) t.join();
   }
+  for (int a = 0; a < job_count; ++a)
+    if (errors[a]) std::rethrow_exception(errors[a]);
+  int best = 0;
+  for (int a = 1; a < job_count; ++a)
+    if (better(attempts[a], attempts[best])) best = a;
+  // Where every fine attempt has a defect (a worst-element measure below 0.3, not a minimum merely short
+  // of 0.5), the grids with margin everywhere may do better (the real jaw at 35,000 hexes: 0.24 at best
+  // with either core, 0.35 with margin everywhere), so they are tried too and the best of all kept.
+  constexpr double kDefect = 0.3;
+  if (attempts[0].fine && worst_measure(attempts[best].report.optimize.phases.back().quality) < kDefect) {
+    const int from = job_count;
+    for (int a = 0; a < grids; ++a) jobs[job_count++] = {shifts[a], CoreRule::kMargin};
+    std::atomic<int> next_retry{from};
+    auto retry = [&](bool quiet) {
+      const QuietThread quiet_thread(quiet);
+      for (int a = next_retry++; a < job_count; a = next_retry++) run_job(a);
+    };
+    std::vector<std::thread> helpers;
+    for (int t = 1; t < std::clamp(options.threads, 1, grids); ++t) helpers.emplace_back(retry, true);
+    retry(false);
+    for (std::thread& t : helpers) t.join();
+    for (int a = from; a < job_count; ++a)
+      if (errors[a]) std::rethrow_exception(errors[a]);
+    for (int a = from; a < job_count; ++a)
+      if (better(attempts[a], attempts[best])) best = a;
+  }
+  const int counted = job_count;
+  GridMeshReport report = std::move(attempts[best].report);
+  HexMesh mesh = std::move(attempts[best].mesh);
+  const Selection kept = std::move(attempts[best].selection);
+  const std::vector<Vec3> kept_pillowed = std::move(attempts[best].pillowed);  // nodes before optimization
+  report.attempts = counted;
 
   auto t0 = std::chrono::steady_clock::now();
   if (options.optimize.mean_jacobian_sweeps > 0) {

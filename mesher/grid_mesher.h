@@ -11,21 +11,24 @@
 //      a few secant steps on the actual counts;
 //   2. core: the grid cells whose centre lies inside the surface at a distance of at least margin * h, or
 //      with the default negative margin outside at most -margin * h (cells that reach well into the solid,
-//      so that plates thinner than a cell, like the coronoid process, keep a sheet of cells; with fine cells
-//      only where the solid is thinner than a cell, elsewhere within thick_margin); inside by crossing
-//      parity along grid columns, distances from the AABB tree. Cells are added until no two cells
-//      share only an edge or a vertex and the core boundary is a 2-manifold (this also joins parts that
-//      touch the rest only along an edge), the largest face-connected component is kept and enclosed
-//      cavities are filled;
+//      so that plates thinner than a cell, like the coronoid process, keep a sheet of cells); with fine
+//      cells either fine_margin everywhere (the plain core: the cells whose centre lies inside) or margin
+//      only where the solid is thinner than a cell and thick_margin elsewhere (the thick-margin core), on
+//      different grids (step 5); inside by crossing parity along grid columns, distances from the AABB tree.
+//      Cells are added until no two cells share only an edge or a vertex and the core boundary is a
+//      2-manifold (this also joins parts that touch the rest only along an edge), the largest face-connected
+//      component is kept and enclosed cavities are filled;
 //   3. pillow layer: core boundary vertices outside or near the surface are pulled below it, then each gets
 //      a copy on the surface (along the vertex normal, or the closest point), and each core boundary quad one
 //      hex to it, so no hex has two boundary faces;
 //   4. optimize_hex_mesh with the boundary sliding on the surface, resting nodes skipped, and its
 //      worst-element pass (hexes with a scaled Jacobian or 3 / kappa below 0.5; both stages twice);
 //   5. steps 1-4 again on the grid shifted by half a cell, then by a quarter; the mesh with the fewest
-//      inverted hexes, then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept;
-//      where thick_margin applied and that measure stays below 0.3, the three grids again with the plain
-//      margin, the best of the six kept (attempts = 6);
+//      inverted hexes, then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept
+//      (with fine cells: the higher mean where both measures reach mean_tie_break). With fine cells four
+//      attempts: the plain core unshifted and shifted by half a cell, the thick-margin core shifted by half
+//      and by a quarter; where the best of them has a measure below 0.3, the three grids again with margin
+//      everywhere (attempts = 7);
 //   6. on the kept mesh only, improve_mean_jacobian raises the mean scaled Jacobian without lowering that
 //      measure (boundary nodes sliding within worst_element_reach of where the pillow layer put them).
 // Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
@@ -54,16 +57,22 @@ struct GridMeshOptions {
   // cells whose centre lies up to -margin * h outside (cells reaching into the solid), so that parts
   // thinner than a cell stay in the core.
   double margin = -0.4;
-  // With fine cells (the solid's mean thickness 2 V / A at least thick_margin_cells cells), an outside cell
-  // whose centre lies farther out than thick_margin * h is kept only where the solid is thinner than a
-  // cell: fewer cells reach out of the thicker parts, so their pillow hexes are thicker. Coarser grids use
-  // margin everywhere (with the solid 1 to 3 cells thick, every cell reaching into it counts).
+  // Fine cells: the solid's mean thickness 2 V / A is at least thick_margin_cells cells. Coarser grids use
+  // margin everywhere (with the solid 1 to 3 cells thick, every cell reaching into it counts). Fine grids
+  // use either fine_margin everywhere (the plain core: fewer cells reach out of the solid, so the pillow
+  // hexes are thicker; the better means) or the thick-margin core: an outside cell whose centre lies
+  // farther out than thick_margin * h (but within -margin * h) is kept only where the solid is thinner than
+  // a cell, so thin plates keep their cells. Between two fine grids whose min(scaled Jacobian, 3 / kappa)
+  // are both at least mean_tie_break, the one with the higher mean scaled Jacobian is kept.
+  double fine_margin = 0.0;
+  double mean_tie_break = 0.5;
   double thick_margin = -0.2;
   double thick_margin_cells = 3.0;
-  // Grids tried, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3). The mesh with
-  // the fewest inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
+  // Grid positions, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3; with fine cells
+  // the plain core on the first two, the thick-margin core on all but the first). The mesh with the fewest
+  // inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
   int grids = 3;
-  // Grids meshed at once, each in its own thread (1 to grids); the mesh does not depend on it.
+  // Grids meshed at once, each in its own thread (1 to 4); the mesh does not depend on it.
   int threads = 2;
   // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass, twice,
   // and the mean stage (on the kept grid only).
@@ -109,7 +118,7 @@ struct MeshFidelity {
 };
 
 struct GridMeshReport {
-  int attempts = 1;           // grids tried (GridMeshOptions::grids, twice with the plain-margin retry)
+  int attempts = 1;           // grids tried (GridMeshOptions::grids; with fine cells 4, or 7 with the retry)
   double cell_size = 0;       // h, mm (this and the fields below describe the kept grid)
   std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;
