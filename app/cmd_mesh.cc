@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -52,6 +53,7 @@ struct MeshOptions {
   bool allow_invalid = false;
   bool fit_volume = false;
   double margin = GridMeshOptions{}.margin;
+  bool margin_given = false;        // --margin on the command line: that margin everywhere, on three grids
   std::string quad_surface;         // --method sheets
   std::string order = "geometric";  // --method sheets
   std::string landmarks;            // --method sheets on a SURFACE; names unresolved parts for grid
@@ -185,6 +187,8 @@ void run_mesh(const MeshOptions& o) {
   GridMeshOptions options;
   options.target_hexes = o.target;
   options.margin = o.margin;
+  // An explicit margin is a request for that core: no automatic choice of cores for fine cells.
+  if (o.margin_given) options.thick_margin_cells = std::numeric_limits<double>::infinity();
   GridMeshReport report;
   HexMesh mesh = grid_mesh(surface, options, &report);
   std::optional<BoundaryFitReport> fit;
@@ -245,13 +249,14 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")->default_val(2500);
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required();
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
-  cmd->add_option(
-         "--margin", o->margin,
-         "Core cells have their centre at least this many cell sizes inside the surface (negative: "
-         "at most that far outside); the pillow layer fills the rest (smaller keeps thinner parts in "
-         "the core)")
-      ->check(CLI::Range(-0.8, 2.0))
-      ->default_val(o->margin);
+  CLI::Option* margin =
+      cmd->add_option("--margin", o->margin,
+                      "Core cells have their centre at least this many cell sizes inside the surface "
+                      "(negative: at most that far outside), on every grid; the pillow layer fills the rest "
+                      "(smaller keeps thinner parts in the core). Without it the mesher chooses: -0.4, and "
+                      "for fine cells the better of two cores (docs/meshing.md)")
+          ->check(CLI::Range(-0.8, 2.0))
+          ->default_val(o->margin);
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "--method grid: move the boundary nodes off the surface along their normals until the "
                 "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "
@@ -259,7 +264,10 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");
   add_refine_options(*cmd, o->refine);
-  cmd->callback([o] { run_mesh(*o); });
+  cmd->callback([o, margin] {
+    o->margin_given = margin->count() > 0;
+    run_mesh(*o);
+  });
 }
 
 }  // namespace hexbite

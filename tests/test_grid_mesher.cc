@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_boundary.h"
@@ -401,6 +402,21 @@ TEST(MeshCommand, WritesAValidMesh) {
   EXPECT_NE(r.out.find("\"phases\""), std::string::npos);
   const HexMesh m = read_vtu(dir + "/m.vtu");
   EXPECT_EQ(summarize_quality(m).inverted, 0);
+}
+
+// Fine cells (1,500 hexes in a 10 mm sphere) get the automatic choice of cores, four grid attempts; an
+// explicit --margin asks for that margin everywhere, on the three plain grid positions.
+TEST(MeshCommand, ExplicitMarginMeansOneCore) {
+  const std::string dir = test::temp_dir();
+  write_surface(dir + "/sphere.stl", icosphere(10.0, 3));
+  const auto chosen = test::run_hexbite(
+      {"mesh", dir + "/sphere.stl", "--target-hexes", "1500", "-o", dir + "/a.vtu", "--json"});
+  ASSERT_EQ(chosen.exit_code, 0) << chosen.err;
+  EXPECT_EQ(nlohmann::json::parse(chosen.out)["grid_attempts"], 4);
+  const auto given = test::run_hexbite({"mesh", dir + "/sphere.stl", "--target-hexes", "1500", "--margin",
+                                        "-0.4", "-o", dir + "/b.vtu", "--json"});
+  ASSERT_EQ(given.exit_code, 0) << given.err;
+  EXPECT_EQ(nlohmann::json::parse(given.out)["grid_attempts"], 3);
 }
 
 }  // namespace
