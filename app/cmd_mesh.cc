@@ -159,15 +159,16 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
 }
 
 void run_mesh(const MeshOptions& o) {
-  if (o.fit_volume && o.method != "grid")
+  if (o.fit_volume && !o.quad_surface.empty())
     throw InputError(
-        "--fit-volume moves the boundary nodes of a --method grid mesh; --method sheets keeps its quad "
-        "surface (or the input's) as the boundary: drop --fit-volume, or use --method grid");
+        "--fit-volume moves boundary nodes off the SURFACE, but a mesh of --quad-surface keeps that quad "
+        "surface exactly as its boundary: drop --fit-volume, or mesh the triangulated SURFACE");
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
     return run_mesh_sheets_surface({{o.surface, o.landmarks, o.units, 0, o.output, o.json, o.refine},
                                     o.target,
                                     o.order,
-                                    o.allow_invalid});
+                                    o.allow_invalid,
+                                    o.fit_volume});
   if (!o.refine.at.empty())
     throw InputError(
         "--refine-at refines the quad surface that --method sheets places on a mandible SURFACE; "
@@ -258,7 +259,7 @@ void add_mesh_command(CLI::App& app) {
           ->check(CLI::Range(-0.8, 2.0))
           ->default_val(o->margin);
   cmd->add_flag("--fit-volume", o->fit_volume,
-                "--method grid: move the boundary nodes off the surface along their normals until the "
+                "Move the boundary nodes off the SURFACE along their normals until the "
                 "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "
                 "quarter edge from the surface)");
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");

@@ -22,6 +22,7 @@
 #include "mesher/quad_surface_placement.h"
 #include "mesher/surface_check.h"
 #include "mesher/units.h"
+#include "postprocess/quality_json.h"
 
 namespace hexbite {
 
@@ -234,6 +235,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   std::unique_ptr<Landmarks> landmarks;
   if (!qo.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(qo.landmarks, scale));
   options.refinement = refinement_options(qo.refine, landmarks.get(), qo.landmarks);
+  options.fit_volume = o.fit_volume;
   MandibleSheetReport sheet_report;
   HexMesh mesh;
   try {
@@ -270,6 +272,8 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
                      {"mesh_to_surface_mm", fidelity.hausdorff_mesh_to_surface},
                      {"surface_to_mesh_mm", fidelity.hausdorff_surface_to_mesh},
                      {"volume_difference", fidelity.volume_difference}};
+    j["volume_fit"] =
+        sheet_report.volume_fit ? volume_fit_to_json(*sheet_report.volume_fit) : nlohmann::json();
     j["output"] = write ? nlohmann::json(qo.output) : nlohmann::json();
     std::cout << j.dump(2) << '\n';
   } else if (!is_quiet()) {
@@ -292,6 +296,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
         fidelity.hausdorff, fidelity.hausdorff_mesh_to_surface, fidelity.hausdorff_surface_to_mesh,
         100.0 * fidelity.volume_difference);
     out << line;
+    if (sheet_report.volume_fit) out << "volume fit: " << describe(*sheet_report.volume_fit) << '\n';
     std::snprintf(line, sizeof line,
                   "time: quad surface %.2f s, elimination %.2f s, embedding %.2f s, total %.2f s\n",
                   quad_report.seconds, report.seconds_elimination, report.seconds_embedding, total_seconds);

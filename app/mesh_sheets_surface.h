@@ -47,6 +47,7 @@ struct MeshSheetsSurfaceOptions {
   long target_hexes = 2500;         // sets quad.target_quads through quads_for_target_hexes()
   std::string order = "geometric";  // parse_elimination_order()
   bool allow_invalid = false;
+  bool fit_volume = false;  // MandibleSheetOptions::fit_volume
 };
 
 // mesh SURFACE --method sheets: mesh_mandible_by_sheets() (quad surface, cycle elimination, a pillow layer

@@ -62,6 +62,16 @@ Geometry build_geometry(const Scenario& s) {
   return g;
 }
 
+// The line a run prints for mesh.fit_volume.
+void info_volume_fit(const BoundaryFitReport& fit, const MeshFidelity& fidelity) {
+  char line[200];
+  std::snprintf(
+      line, sizeof line,
+      "mesh.fit_volume: %d of %d boundary nodes moved, up to %.2f mm off the surface; volume %+.2f %%",
+      fit.moved_nodes, fit.boundary_nodes, fit.max_node_offset, 100.0 * fidelity.volume_difference);
+  info(line);
+}
+
 // `method: grid`. A mesh that stays inverted cannot be solved on.
 HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity) {
   GridMeshOptions options;
@@ -72,13 +82,7 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
     const SurfaceProjector projector(geometry.surface);
     const BoundaryFitReport fit = fit_boundary_to_volume(mesh, projector, {});
     report.fidelity = measure_fidelity(mesh, projector);
-    char line[200];
-    std::snprintf(line, sizeof line,
-                  "mesh.fit_volume: %d of %d boundary nodes moved, up to %.2f mm off the surface; volume "
-                  "%+.2f %%",
-                  fit.moved_nodes, fit.boundary_nodes, fit.max_node_offset,
-                  100.0 * report.fidelity.volume_difference);
-    info(line);
+    info_volume_fit(fit, report.fidelity);
   }
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
@@ -113,6 +117,7 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
                                                  support.name + "'s point (mesh.refine_at_bite)");
       }
   }
+  options.fit_volume = s.mesh.fit_volume;
   MandibleSheetReport report;
   HexMesh mesh;
   try {
@@ -129,6 +134,7 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     throw RunError(std::string("the sheet mesher failed: ") + e.what() + "; use method: grid");
   }
   *fidelity = report.fidelity;
+  if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
   for (const LocalRefinementSite& site : report.refinement.sites) {
     char line[256];
     std::snprintf(

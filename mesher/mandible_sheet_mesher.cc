@@ -123,6 +123,7 @@ HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* land
   for (int v : report.quad.landmark_vertices) fixed[v] = 1;
   const SurfaceProjector projector(surface);
   sheets.optimize = optimize_hex_mesh(mesh, &projector, fixed, surface_optimizer_options());
+  if (o.fit_volume) report.volume_fit = fit_boundary_to_volume(mesh, projector, fixed);
   sheets.hexes = static_cast<int>(mesh.hexes.size());
   sheets.interior_vertices = static_cast<int>(mesh.vertices.size() - quads.vertices.size());
   sheets.quality = summarize_quality(mesh);

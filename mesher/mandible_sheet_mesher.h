@@ -35,9 +35,12 @@
 // Deterministic: single-threaded, fixed orders.
 #pragma once
 
+#include <optional>
+
 #include <string>
 #include <vector>
 
+#include "mesher/boundary_fit.h"
 #include "mesher/cycle_elimination.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh.h"
@@ -54,6 +57,9 @@ struct MandibleSheetOptions {
   std::string surface_name = "the surface";  // names the input in error messages
   std::string landmark_file;                 // names the landmarks in error messages
   LocalRefinementOptions refinement;         // around refinement.points; none by default
+  // After the optimization, boundary nodes (the landmark nodes excepted) move off the surface until the
+  // boundary quads straddle it (mesher/boundary_fit.h); off by default.
+  bool fit_volume = false;
 };
 
 struct MandibleSheetReport {
@@ -64,8 +70,9 @@ struct MandibleSheetReport {
   // mesh (pillow layer and sliding optimization included).
   SheetMeshReport sheets;
   int pillow_hexes = 0;   // one per quad of the quad surface
-  MeshFidelity fidelity;  // the final (slid) boundary against the input
-  int inverted = 0;       // hexes left inverted; sheets.quality.inverted_hexes lists them
+  MeshFidelity fidelity;  // the final (slid, and with fit_volume fitted) boundary against the input
+  std::optional<BoundaryFitReport> volume_fit;  // with MandibleSheetOptions::fit_volume
+  int inverted = 0;  // hexes left inverted; sheets.quality.inverted_hexes lists them
 };
 
 // Step 1 alone (`hexbite quad from-mandible`): the quad surface of about target_quads quads, refined

@@ -433,13 +433,7 @@ MeshSettings parse_mesh(const Value& v) {
                       std::to_string(kMaxRefineLevels) +
                       " (rings of quads around the bite point); the default is 3");
   }
-  if (auto x = map.find("fit_volume")) {
-    m.fit_volume = to_bool(*x);
-    if (m.fit_volume && m.method != MeshMethod::kGrid)
-      fail(x->at,
-           "mesh.fit_volume moves the boundary nodes of the grid mesher, but mesh.method is sheets, whose "
-           "boundary is its quad surface; write method: grid in mesh, or remove fit_volume");
-  }
+  if (auto x = map.find("fit_volume")) m.fit_volume = to_bool(*x);
   return m;
 }
 

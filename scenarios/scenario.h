@@ -73,8 +73,8 @@ struct MeshSettings {
   double refine_radius_mm = 8.0;
   int refine_levels = 3;
   SourceLocation refine_at_bite_at;  // where refine_at_bite was written
-  // method grid only: boundary nodes moved off the surface until the mesh's volume matches
-  // (mesher/boundary_fit.h), on the coarse mesh and on every validation level.
+  // boundary nodes moved off the surface until the mesh's volume matches (mesher/boundary_fit.h), on the
+  // coarse mesh and on every validation level.
   bool fit_volume = false;
 };
 

@@ -1,5 +1,5 @@
 // Volume fitting of a hex mesh's boundary (mesher/boundary_fit.h) on the built-in mandible's grid mesh, and
-// `hexbite mesh --fit-volume`.
+// `hexbite mesh --fit-volume` (both methods on a SURFACE) and `hexbite refine --fit-volume`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -118,7 +118,7 @@ TEST(BoundaryFit, KeepsFixedNodesAndSkipsInvertedMeshes) {
   EXPECT_EQ(inverted.vertices, copy.vertices);
 }
 
-TEST(MeshCommand, FitVolumeInMeshAndRefineAndForTheGridMethodOnly) {
+TEST(MeshCommand, FitVolumeInMeshAndRefineButNotForAQuadSurface) {
   const std::string dir = test::temp_dir();
   write_surface(dir + "/mandible.stl", mandible_mesh().mandible.surface);
   const auto r = test::run_hexbite({"mesh", dir + "/mandible.stl", "--method", "grid", "--target-hexes",
@@ -157,11 +157,25 @@ TEST(MeshCommand, FitVolumeInMeshAndRefineAndForTheGridMethodOnly) {
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_TRUE(nlohmann::json::parse(plain.out)["volume_fit"].is_null());
 
+  // The sheet mesher on the SURFACE fits its slid boundary too (landmark nodes held): measured -4.25 % ->
+  // -0.68 %, SJ mean 0.903 -> 0.892.
   const auto sheets = test::run_hexbite(
-      {"mesh", dir + "/mandible.stl", "--method", "sheets", "--fit-volume", "-o", dir + "/s.vtu"});
-  EXPECT_EQ(sheets.exit_code, 2);
-  EXPECT_NE(sheets.err.find("--fit-volume"), std::string::npos) << sheets.err;
-  EXPECT_FALSE(std::filesystem::exists(dir + "/s.vtu"));
+      {"mesh", dir + "/mandible.stl", "--method", "sheets", "--fit-volume", "-o", dir + "/s.vtu", "--json"});
+  ASSERT_EQ(sheets.exit_code, 0) << sheets.err;
+  const auto sj = nlohmann::json::parse(sheets.out);
+  ASSERT_TRUE(sj["volume_fit"].is_object()) << sheets.out;
+  EXPECT_LT(std::fabs(sj["fidelity"]["volume_difference"].get<double>()), 0.015);
+  EXPECT_EQ(sj["quality"]["inverted"], 0);
+
+  // A mesh of a quad surface keeps that surface as its boundary: no fit.
+  test::write_file(dir + "/cube.obj",
+                   "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                   "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+  const auto quads = test::run_hexbite({"mesh", "--method", "sheets", "--quad-surface", dir + "/cube.obj",
+                                        "--fit-volume", "-o", dir + "/q.vtu"});
+  EXPECT_EQ(quads.exit_code, 2);
+  EXPECT_NE(quads.err.find("--fit-volume"), std::string::npos) << quads.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/q.vtu"));
 }
 
 }  // namespace

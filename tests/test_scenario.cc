@@ -273,13 +273,17 @@ TEST(ScenarioErrors, UnknownKeySuggestsTheClosest) {
                   "did you mean 'dentate'?");
 }
 
-// mesh.fit_volume (the grid mesher's boundary moved off the surface until the volume matches) is read for
-// method grid and refused, at its line, for method sheets, whose boundary is its quad surface.
-TEST(ScenarioErrors, FitVolumeIsForTheGridMethodOnly) {
+// mesh.fit_volume (the boundary nodes moved off the surface until the volume matches) is read for both
+// methods, and is false by default.
+TEST(Scenario, FitVolumeIsReadForBothMethods) {
   EXPECT_FALSE(load_scenario(write_scenario(kValid)).mesh.fit_volume);
   EXPECT_TRUE(load_scenario(write_scenario(kValid + "mesh: {fit_volume: true}\n")).mesh.fit_volume);
-  EXPECT_ERROR_AT(error_of(kValid + "mesh:\n  method: sheets\n  fit_volume: true\n"), 13,
-                  "mesh.fit_volume moves the boundary nodes of the grid mesher, but mesh.method is sheets");
+  const Scenario sheets =
+      load_scenario(write_scenario(kValid + "mesh:\n  method: sheets\n  fit_volume: true\n"));
+  EXPECT_TRUE(sheets.mesh.fit_volume);
+  EXPECT_EQ(sheets.mesh.method, MeshMethod::kSheets);
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {fit_volume: maybe}\n"), 11,
+                  "mesh.fit_volume must be true or false");
 }
 
 TEST(ScenarioErrors, RepeatedKey) {
