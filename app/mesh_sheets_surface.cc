@@ -87,12 +87,12 @@ std::string quad_text(const std::string& surface, const MandibleQuadReport& r,
   if (r.fidelity_rounds > 0) {
     std::snprintf(line, sizeof line,
                   "fidelity rings: %d rounds, +%d quads around the regions still farther than %.1f mm\n",
-                  r.fidelity_rounds, r.fidelity_quads_added, MandibleQuadOptions{}.snap_threshold_mm);
+                  r.fidelity_rounds, r.fidelity_quads_added, r.fidelity_goal_mm);
     out << line;
   } else if (r.fidelity_undone_rounds > 0) {
     std::snprintf(line, sizeof line,
                   "fidelity rings: %d rounds undone (they did not bring the quads within %.1f mm)\n",
-                  r.fidelity_undone_rounds, MandibleQuadOptions{}.snap_threshold_mm);
+                  r.fidelity_undone_rounds, r.fidelity_goal_mm);
     out << line;
   }
   std::snprintf(line, sizeof line,

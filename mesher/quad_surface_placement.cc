@@ -840,6 +840,7 @@ FarPoints measure_far(const QuadSurface& fine, const PlacementSurface& s, double
 void refine_for_fidelity(QuadSurface& fine, const PlacementSurface& s, std::vector<char>& fixed,
                          std::vector<Vec3>* surface_normal, const MandibleQuadOptions& o,
                          MandibleQuadReport* report) {
+  report->fidelity_goal_mm = o.snap_threshold_mm;
   FarPoints current = measure_far(fine, s, o.snap_threshold_mm);
   if (current.hausdorff > o.max_hausdorff_mm) return;  // not a mandible: step 10 rejects it
   const int quads_before = static_cast<int>(fine.quads.size());

@@ -142,6 +142,7 @@ struct MandibleQuadReport {
   // of the surface before step 9.
   int fidelity_rounds = 0;
   int fidelity_undone_rounds = 0;  // rounds undone because they did not reach snap_threshold_mm
+  double fidelity_goal_mm = 0;     // that goal (MandibleQuadOptions::snap_threshold_mm)
   int fidelity_quads_added = 0;
   std::vector<std::array<int, 2>> ring_rungs;
   double seconds = 0;
