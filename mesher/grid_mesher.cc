@@ -800,11 +800,12 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   int best = 0;
   for (int a = 1; a < job_count; ++a)
     if (better(attempts[a], attempts[best])) best = a;
-  // Where every fine attempt has a defect (a worst-element measure below 0.3, not a minimum merely short
-  // of 0.5), the grids with margin everywhere may do better (the real jaw at 35,000 hexes: 0.24 at best
-  // with either core, 0.35 with margin everywhere), so they are tried too and the best of all kept.
-  constexpr double kDefect = 0.3;
-  if (attempts[0].fine && worst_measure(attempts[best].report.optimize.phases.back().quality) < kDefect) {
+  // Where every fine attempt has a defect (a worst-element measure below retry_below, 0.3, not a minimum
+  // merely short of 0.5), the grids with margin everywhere may do better (the real jaw at 35,000 hexes:
+  // 0.24 at best with either core, 0.35 with margin everywhere), so they are tried too and the best of all
+  // kept.
+  if (attempts[0].fine &&
+      worst_measure(attempts[best].report.optimize.phases.back().quality) < options.retry_below) {
     const int from = job_count;
     for (int a = 0; a < grids; ++a) jobs[job_count++] = {shifts[a], CoreRule::kMargin};
     std::atomic<int> next_retry{from};

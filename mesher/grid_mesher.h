@@ -66,6 +66,9 @@ struct GridMeshOptions {
   // are both at least mean_tie_break, the one with the higher mean scaled Jacobian is kept.
   double fine_margin = 0.0;
   double mean_tie_break = 0.5;
+  // Fine cells: when the best attempt's min(scaled Jacobian, 3 / kappa) is below this (a defect, not a
+  // minimum merely short of 0.5), the grids are meshed again with margin everywhere (attempts = 7).
+  double retry_below = 0.3;
   double thick_margin = -0.2;
   double thick_margin_cells = 3.0;
   // Grid positions, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3; with fine cells

@@ -210,6 +210,24 @@ TEST(GridMesher, FineCellsKeepTheBetterCore) {
   EXPECT_EQ(c.hexes, d.hexes);
 }
 
+// The defect retry: no small surface leaves a defect (a worst-element measure below 0.3) in all four fine
+// attempts, so the threshold is raised out of reach: the three margin-everywhere grids are meshed too (7
+// attempts) and the kept mesh is the best of all seven, never worse than the best of the first four.
+TEST(GridMesher, DefectRetryMeshesThreeMoreGridsAndKeepsTheBest) {
+  const TriSurface sphere = icosphere(10.0, 3);
+  auto worst = [](const QualitySummary& q) { return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max); };
+  GridMeshOptions options;
+  options.target_hexes = 1500;
+  GridMeshReport four_report, seven_report;
+  const QualitySummary four = summarize_quality(grid_mesh(sphere, options, &four_report));
+  options.retry_below = 2.0;
+  const QualitySummary seven = summarize_quality(grid_mesh(sphere, options, &seven_report));
+  EXPECT_EQ(four_report.attempts, 4);
+  EXPECT_EQ(seven_report.attempts, 7);
+  EXPECT_EQ(seven.inverted, 0);
+  EXPECT_GE(worst(seven), worst(four) - 1e-12);
+}
+
 TEST(GridMesher, DeterministicSameBytes) {
   const TriSurface sphere = icosphere(10.0, 3);
   GridMeshOptions options;
