@@ -12,13 +12,11 @@
 // cannot resolve are named by their nearest landmark and muscle insertion. --fit-volume then moves the
 // boundary nodes off the surface until the mesh holds the surface's volume (mesher/boundary_fit.h).
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <sstream>
 
 #include "app/commands.h"
@@ -32,7 +30,6 @@
 #include "mesher/hex_quality.h"
 #include "mesher/landmarks.h"
 #include "mesher/surface_check.h"
-#include "mesher/surface_projector.h"
 #include "mesher/units.h"
 #include "postprocess/quality_json.h"
 
@@ -86,8 +83,7 @@ std::string phase_table(const OptimizeReport& r) {
   return out.str();
 }
 
-std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
-                        const BoundaryFitReport* fit) {
+std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r) {
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
   out << "Meshed " << o.surface << " (grid + pillow): " << mesh.hexes.size() << " hexes (" << r.core_hexes
@@ -110,7 +106,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << " mm\n";
   out << "volume: mesh " << fmt("%.1f", f.mesh_volume) << " mm^3, surface " << fmt("%.1f", f.surface_volume)
       << " mm^3, difference " << fmt("%+.2f", 100.0 * f.volume_difference) << " %\n";
-  if (fit != nullptr) out << "volume fit: " << describe(*fit) << '\n';
+  if (r.volume_fit) out << "volume fit: " << describe(*r.volume_fit) << '\n';
   if (!f.unresolved.empty()) {
     out << "not resolved at this size (" << f.unresolved.size() << " regions):\n";
     const std::size_t shown = std::min<std::size_t>(f.unresolved.size(), 10);
@@ -121,8 +117,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   return out.str();
 }
 
-nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
-                           const BoundaryFitReport* fit, bool written) {
+nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r, bool written) {
   nlohmann::json j;
   j["surface"] = o.surface;
   j["method"] = o.method;
@@ -152,7 +147,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
                   {"fidelity", r.seconds_fidelity},
                   {"total", r.seconds_total}};
   j["fidelity"] = fidelity_to_json(r.fidelity);
-  j["volume_fit"] = fit ? volume_fit_to_json(*fit) : nlohmann::json();
+  j["volume_fit"] = r.volume_fit ? volume_fit_to_json(*r.volume_fit) : nlohmann::json();
   j["inverted"] = r.optimize.inverted;
   j["output"] = written ? nlohmann::json(o.output) : nlohmann::json();
   return j;
@@ -188,20 +183,11 @@ void run_mesh(const MeshOptions& o) {
   GridMeshOptions options;
   options.target_hexes = o.target;
   options.margin = o.margin;
+  options.fit_volume = o.fit_volume;
   // An explicit margin is a request for that core: no automatic choice of cores for fine cells.
   if (o.margin_given) options.thick_margin_cells = std::numeric_limits<double>::infinity();
   GridMeshReport report;
-  HexMesh mesh = grid_mesh(surface, options, &report);
-  std::optional<BoundaryFitReport> fit;
-  if (o.fit_volume) {
-    const SurfaceProjector projector(surface);
-    fit = fit_boundary_to_volume(mesh, projector, {});
-    report.optimize.phases.push_back({"volume fit", summarize_quality(mesh), fit->seconds});
-    const auto t0 = std::chrono::steady_clock::now();
-    report.fidelity = measure_fidelity(mesh, projector);
-    report.seconds_fidelity = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    report.seconds_total += fit->seconds + report.seconds_fidelity;
-  }
+  const HexMesh mesh = grid_mesh(surface, options, &report);
   if (landmarks) name_unresolved_parts(*landmarks, report.fidelity.unresolved);
   const QualitySummary& final_quality = report.optimize.phases.back().quality;
   const bool valid = final_quality.inverted == 0;
@@ -209,9 +195,9 @@ void run_mesh(const MeshOptions& o) {
   if (write) write_vtu(o.output, mesh);
 
   if (o.json)
-    std::cout << report_json(o, mesh, report, fit ? &*fit : nullptr, write).dump(2) << '\n';
+    std::cout << report_json(o, mesh, report, write).dump(2) << '\n';
   else if (!is_quiet())
-    std::cout << report_text(o, mesh, report, fit ? &*fit : nullptr);
+    std::cout << report_text(o, mesh, report);
   if (!valid) {
     const std::string list = hex_list_text(mesh, final_quality.inverted_hexes);
     if (o.allow_invalid) {

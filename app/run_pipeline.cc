@@ -76,14 +76,10 @@ void info_volume_fit(const BoundaryFitReport& fit, const MeshFidelity& fidelity)
 HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity) {
   GridMeshOptions options;
   options.target_hexes = s.mesh.target_hexes;
+  options.fit_volume = s.mesh.fit_volume;
   GridMeshReport report;
   HexMesh mesh = grid_mesh(geometry.surface, options, &report);
-  if (s.mesh.fit_volume && report.optimize.inverted == 0) {
-    const SurfaceProjector projector(geometry.surface);
-    const BoundaryFitReport fit = fit_boundary_to_volume(mesh, projector, {});
-    report.fidelity = measure_fidelity(mesh, projector);
-    info_volume_fit(fit, report.fidelity);
-  }
+  if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
   for (const UnresolvedPart& part : report.fidelity.unresolved) info("not resolved: " + part.what);

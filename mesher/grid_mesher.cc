@@ -842,6 +842,10 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     report.optimize.energy_after = condition_energy(mesh, nullptr);
     report.seconds_optimize += seconds_since(t0);
   }
+  if (options.fit_volume && report.optimize.inverted == 0) {
+    report.volume_fit = fit_boundary_to_volume(mesh, projector, {});
+    report.optimize.phases.push_back({"volume fit", summarize_quality(mesh), report.volume_fit->seconds});
+  }
   t0 = std::chrono::steady_clock::now();
   report.fidelity = measure_fidelity(mesh, projector);
   if (kept.dropped > 0) {

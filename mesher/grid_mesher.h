@@ -39,9 +39,11 @@
 // Deterministic: same surface and options, same mesh (bit for bit), whatever the number of threads.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "mesher/boundary_fit.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_optimize.h"
 #include "mesher/landmarks.h"
@@ -66,6 +68,9 @@ struct GridMeshOptions {
   // are both at least mean_tie_break, the one with the higher mean scaled Jacobian is kept.
   double fine_margin = 0.0;
   double mean_tie_break = 0.5;
+  // After the mean stage, boundary nodes move off the surface until the boundary quads straddle it
+  // (mesher/boundary_fit.h; report.volume_fit, a phase "volume fit"); off by default.
+  bool fit_volume = false;
   // Fine cells: when the best attempt's min(scaled Jacobian, 3 / kappa) is below this (a defect, not a
   // minimum merely short of 0.5), the grids are meshed again with margin everywhere (attempts = 7).
   double retry_below = 0.3;
@@ -129,6 +134,7 @@ struct GridMeshReport {
   int cells_added_for_manifold = 0;
   int cells_in_dropped_components = 0;
   OptimizeReport optimize;
+  std::optional<BoundaryFitReport> volume_fit;  // with GridMeshOptions::fit_volume and no inverted hex
   MeshFidelity fidelity;
   // The kept grid's phases; seconds_total covers every grid tried.
   double seconds_core = 0, seconds_pillow = 0, seconds_optimize = 0, seconds_fidelity = 0, seconds_total = 0;
