@@ -7,12 +7,10 @@
 // compared node by node. A refined mesh with inverted hexes is a failed run (exit 1, naming them with their
 // centroids) and is not written.
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <sstream>
 
 #include "app/commands.h"
@@ -59,7 +57,7 @@ std::string quality_row(const std::string& stage, const QualitySummary& q, doubl
   return line;
 }
 
-std::string report_text(const RefineCliOptions& o, const RefineReport& r, const BoundaryFitReport* fit) {
+std::string report_text(const RefineCliOptions& o, const RefineReport& r) {
   std::ostringstream out;
   out << "Refined " << o.mesh << ": " << o.levels << (o.levels == 1 ? " level, " : " levels, ")
       << r.before.hexes << " -> " << r.after.hexes << " hexes, " << r.before.nodes << " -> " << r.after.nodes
@@ -100,7 +98,7 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r, const 
              "surface "
              "there\n";
   }
-  if (fit != nullptr) out << "volume fit (input nodes kept): " << describe(*fit) << '\n';
+  if (r.volume_fit) out << "volume fit (input nodes kept): " << describe(*r.volume_fit) << '\n';
   double split = 0, project = 0, optimize = 0;
   for (const RefineLevelReport& l : r.levels) {
     split += l.seconds_split;
@@ -113,8 +111,7 @@ std::string report_text(const RefineCliOptions& o, const RefineReport& r, const 
   return out.str();
 }
 
-nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, const BoundaryFitReport* fit,
-                           bool written) {
+nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, bool written) {
   nlohmann::json j;
   j["mesh"] = o.mesh;
   j["surface"] = o.surface.empty() ? nlohmann::json() : nlohmann::json(o.surface);
@@ -148,7 +145,7 @@ nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, con
     levels.push_back(level);
   }
   j["level_reports"] = levels;
-  j["volume_fit"] = fit ? volume_fit_to_json(*fit) : nlohmann::json();
+  j["volume_fit"] = r.volume_fit ? volume_fit_to_json(*r.volume_fit) : nlohmann::json();
   j["seconds_total"] = r.seconds_total;
   j["output"] = written ? nlohmann::json(o.output) : nlohmann::json();
   return j;
@@ -170,24 +167,16 @@ void run_refine(const RefineCliOptions& o) {
 
   RefineOptions options;
   options.levels = o.levels;
+  options.fit_volume = o.fit_volume;
   RefineReport report;
-  HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
+  const HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
   const bool valid = report.after.inverted == 0;
-  std::optional<BoundaryFitReport> fit;
-  if (o.fit_volume && valid) {
-    // The input's nodes keep their places (as the refinement keeps them); the new boundary nodes, which it
-    // put on the surface, are fitted around them.
-    std::vector<char> fixed(fine.vertices.size(), 0);
-    std::fill(fixed.begin(), fixed.begin() + static_cast<std::ptrdiff_t>(coarse.vertices.size()), 1);
-    fit = fit_boundary_to_volume(fine, *projector, fixed);
-    report.after = summarize_quality(fine);
-  }
   if (valid) write_vtu(o.output, fine);
 
   if (o.json)
-    std::cout << report_json(o, report, fit ? &*fit : nullptr, valid).dump(2) << '\n';
+    std::cout << report_json(o, report, valid).dump(2) << '\n';
   else if (!is_quiet())
-    std::cout << report_text(o, report, fit ? &*fit : nullptr);
+    std::cout << report_text(o, report);
   if (!valid) {
     std::string cause;
     if (report.before.inverted > 0)

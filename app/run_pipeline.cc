@@ -366,19 +366,13 @@ RunResult run_pipeline(Scenario scenario, int levels) {
     Progress progress("refine level " + std::to_string(level));
     const auto t = std::chrono::steady_clock::now();
     RefineReport report;
-    const std::size_t coarse_nodes = result.levels.back().mesh.vertices.size();
-    HexMesh fine = refine_to_surface(result.levels.back().mesh, projector.get(), RefineOptions{}, &report);
+    RefineOptions options;
+    options.fit_volume = scenario.mesh.fit_volume;  // the coarse nodes keep their (fitted) places
+    HexMesh fine = refine_to_surface(result.levels.back().mesh, projector.get(), options, &report);
     if (report.after.inverted > 0)
       throw RunError("refinement level " + std::to_string(level) + " left " +
                      std::to_string(report.after.inverted) +
                      " inverted hexes; run with fewer validation levels (--levels) or another target_hexes");
-    if (scenario.mesh.fit_volume) {
-      // The coarse nodes keep their (fitted) positions, as the refinement keeps them; the new boundary
-      // nodes, which it put on the surface, are fitted around them.
-      std::vector<char> fixed(fine.vertices.size(), 0);
-      std::fill(fixed.begin(), fixed.begin() + static_cast<std::ptrdiff_t>(coarse_nodes), 1);
-      fit_boundary_to_volume(fine, *projector, fixed);
-    }
     const double seconds = seconds_since(t);
     result.levels.push_back(prepare_level(scenario, level, std::move(fine)));
     result.levels.back().seconds_mesh = seconds;

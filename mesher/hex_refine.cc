@@ -325,6 +325,12 @@ HexMesh refine_to_surface(const HexMesh& coarse, const SurfaceProjector* surface
     report.levels.push_back(std::move(lr));
   }
   report.after = report.levels.empty() ? report.before : report.levels.back().final_quality;
+  if (options.fit_volume && surface != nullptr && report.after.inverted == 0) {
+    std::vector<char> fixed(mesh.vertices.size(), 0);
+    std::fill(fixed.begin(), fixed.begin() + original_vertices, 1);
+    report.volume_fit = fit_boundary_to_volume(mesh, *surface, fixed);
+    report.after = summarize_quality(mesh);
+  }
   report.seconds_total = seconds_since(t_start);
   if (report_out) *report_out = std::move(report);
   return mesh;

@@ -18,8 +18,10 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
+#include "mesher/boundary_fit.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_optimize.h"
 #include "mesher/hex_quality.h"
@@ -61,6 +63,10 @@ struct RefineOptions {
     o.barycentric_iterations = 0;
     return o;
   }();
+  // With a surface, after the last level: the new boundary nodes, which the projection put on the surface,
+  // are moved off it until the boundary quads straddle it (mesher/boundary_fit.h), the input's nodes held;
+  // for a coarse mesh fitted the same way (GridMeshOptions::fit_volume). Skipped when a hex is inverted.
+  bool fit_volume = false;
 };
 
 struct RefineLevelReport {
@@ -86,6 +92,7 @@ struct RefineReport {
   QualitySummary before;  // the input mesh
   QualitySummary after;   // the final mesh
   std::vector<RefineLevelReport> levels;
+  std::optional<BoundaryFitReport> volume_fit;  // with RefineOptions::fit_volume
   double seconds_total = 0.0;
 };
 
