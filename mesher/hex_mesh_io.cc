@@ -3,17 +3,13 @@
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkCellTypes.h>
-#include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkIdTypeArray.h>
-#include <vtkLogger.h>
 #include <vtkNew.h>
-#include <vtkOutputWindow.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkSmartPointer.h>
-#include <vtkStringOutputWindow.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridWriter.h>
@@ -35,6 +31,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "mesher/hex_quality.h"
+#include "mesher/vtk_messages.h"
 
 namespace hexbite {
 
@@ -118,57 +115,6 @@ std::vector<MeshArray> arrays_of(vtkFieldData* data) {
   return out;
 }
 
-// Collects the error messages a VTK reader emits, so that they reach the user inside an InputError instead
-// of being printed by VTK's output window.
-class ErrorCollector : public vtkCommand {
- public:
-  static ErrorCollector* New() { return new ErrorCollector; }
-  void Execute(vtkObject*, unsigned long, void* call_data) override {
-    if (call_data != nullptr && messages.empty()) messages = static_cast<const char*>(call_data);
-  }
-  std::string messages;
-};
-
-// Routes VTK's global output window into a string while a reader runs, and restores it afterwards. Helper
-// objects inside the reader (the XML parser) report errors there rather than to an observer; their text says
-// what is wrong (for example "no element found" at a given line) and goes into our InputError instead of
-// being printed to the terminal.
-// VTK 9 also sends every error to its logger, which prints to stderr by itself; that sink is muted for the
-// same span. The logger has no getter for the stderr level alone, so the overall cutoff (the stderr level
-// unless a log file was opened) is what gets restored.
-class CapturedVtkOutput {
- public:
-  CapturedVtkOutput()
-      : previous_(vtkOutputWindow::GetInstance()),
-        previous_verbosity_(vtkLogger::GetCurrentVerbosityCutoff()) {
-    vtkOutputWindow::SetInstance(capture_);
-    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
-  }
-  ~CapturedVtkOutput() {
-    vtkLogger::SetStderrVerbosity(previous_verbosity_);
-    vtkOutputWindow::SetInstance(previous_);
-  }
-  std::string text() { return capture_->GetOutput(); }
-
- private:
-  vtkSmartPointer<vtkOutputWindow> previous_;
-  vtkLogger::Verbosity previous_verbosity_;
-  vtkNew<vtkStringOutputWindow> capture_;
-};
-
-// The first VTK message of `text` without its source location prefix ("vtkClass (0x...): ").
-std::string first_vtk_message(const std::string& text) {
-  std::istringstream lines(text);
-  std::string line;
-  while (std::getline(lines, line)) {
-    const auto cut = line.find("): ");
-    if (cut != std::string::npos) line = line.substr(cut + 3);
-    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
-    if (!line.empty() && line.rfind("ERROR: In ", 0) != 0) return line;
-  }
-  return "";
-}
-
 }  // namespace
 
 void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<MeshArray>& cell_arrays,
@@ -216,11 +162,10 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
     writer->SetCompressorTypeToZLib();
     writer->SetHeaderTypeToUInt64();
     writer->SetIdTypeToInt64();
-    vtkNew<ErrorCollector> errors;
-    writer->AddObserver(vtkCommand::ErrorEvent, errors);
-    if (writer->Write() != 1 || !errors->messages.empty())
+    VtkMessageCapture capture;
+    if (writer->Write() != 1 || !capture.errors().empty())
       throw RunError("cannot write '" + path + "': " +
-                     (errors->messages.empty() ? std::string("VTK writer failed") : errors->messages));
+                     (capture.errors().empty() ? std::string("VTK writer failed") : capture.errors()));
   });
 }
 
@@ -229,28 +174,19 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   check_readable(path, "hex mesh");
   const std::string where = "hex mesh '" + path + "'";
   vtkNew<vtkXMLUnstructuredGridReader> reader;
-  vtkNew<ErrorCollector> errors;
-  std::string parser_text;
-  {
-    CapturedVtkOutput capture;
-    if (reader->CanReadFile(path.c_str()) == 0)
-      throw InputError(
-          "cannot read " + where +
-          ": not a VTK XML unstructured grid (.vtu) file; expected a <VTKFile type=\"UnstructuredGrid\"> "
-          "document");
-    reader->SetFileName(path.c_str());
-    reader->AddObserver(vtkCommand::ErrorEvent, errors);
-    reader->Update();
-    parser_text = capture.text();
-  }
+  VtkMessageCapture capture;
+  if (reader->CanReadFile(path.c_str()) == 0)
+    throw InputError(
+        "cannot read " + where +
+        ": not a VTK XML unstructured grid (.vtu) file; expected a <VTKFile type=\"UnstructuredGrid\"> "
+        "document");
+  reader->SetFileName(path.c_str());
+  reader->Update();
   vtkUnstructuredGrid* grid = reader->GetOutput();
   // Warnings (for example about an unknown array type) do not make a file unreadable; errors do.
-  if (!errors->messages.empty() || parser_text.find("ERROR") != std::string::npos || grid == nullptr) {
-    std::string msg = first_vtk_message(parser_text);
-    if (msg.empty()) msg = first_vtk_message(errors->messages);
+  if (!capture.errors().empty() || grid == nullptr)
     throw InputError("cannot read " + where + ": the file is damaged or truncated (VTK: " +
-                     (msg.empty() ? std::string("no output") : msg) + ")");
-  }
+                     (capture.errors().empty() ? std::string("no output") : capture.errors()) + ")");
   const vtkIdType num_points = grid->GetNumberOfPoints();
   const vtkIdType num_cells = grid->GetNumberOfCells();
   if (num_points > std::numeric_limits<int>::max() || num_cells > std::numeric_limits<int>::max())

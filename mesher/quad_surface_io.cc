@@ -2,7 +2,6 @@
 
 #include <vtkCellArray.h>
 #include <vtkNew.h>
-#include <vtkObject.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataReader.h>
@@ -19,6 +18,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/paths.h"
+#include "mesher/vtk_messages.h"
 
 namespace hexbite {
 
@@ -169,42 +169,34 @@ QuadSurface from_polydata(const std::string& path, vtkPolyData* poly) {
   return s;
 }
 
-// VTK readers print their own errors; they are silenced here and replaced by one InputError, because the
-// reader's error code says enough to tell a broken file from a good one.
-class ScopedVtkSilence {
- public:
-  ScopedVtkSilence() : previous_(vtkObject::GetGlobalWarningDisplay()) {
-    vtkObject::GlobalWarningDisplayOff();
-  }
-  ~ScopedVtkSilence() { vtkObject::SetGlobalWarningDisplay(previous_); }
-  ScopedVtkSilence(const ScopedVtkSilence&) = delete;
-  ScopedVtkSilence& operator=(const ScopedVtkSilence&) = delete;
-
- private:
-  int previous_;
-};
+// A reader's error code says a file is broken; VTK's captured explanation says how.
+std::string vtk_explanation(const VtkMessageCapture& capture) {
+  return capture.errors().empty() ? std::string() : " (VTK: " + capture.errors() + ")";
+}
 
 QuadSurface read_vtp(const std::string& path) {
-  ScopedVtkSilence silence;
+  VtkMessageCapture capture;
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str()))
     throw InputError(quoted(path) + " is not a VTK XML polydata (.vtp) file");
   reader->SetFileName(path.c_str());
   reader->Update();
   if (reader->GetErrorCode() != 0)
-    throw InputError(quoted(path) + " could not be read as VTK XML polydata (truncated or corrupt file)");
+    throw InputError(quoted(path) + " could not be read as VTK XML polydata (truncated or corrupt file" +
+                     vtk_explanation(capture) + ")");
   return from_polydata(path, reader->GetOutput());
 }
 
 QuadSurface read_legacy_vtk(const std::string& path) {
-  ScopedVtkSilence silence;
+  VtkMessageCapture capture;
   vtkNew<vtkPolyDataReader> reader;
   reader->SetFileName(path.c_str());
   if (!reader->IsFilePolyData())
     throw InputError(quoted(path) + " is not a legacy VTK polydata file (DATASET POLYDATA)");
   reader->Update();
   if (reader->GetErrorCode() != 0)
-    throw InputError(quoted(path) + " could not be read as legacy VTK polydata (truncated or corrupt file)");
+    throw InputError(quoted(path) + " could not be read as legacy VTK polydata (truncated or corrupt file" +
+                     vtk_explanation(capture) + ")");
   return from_polydata(path, reader->GetOutput());
 }
 

@@ -13,12 +13,9 @@
 #include "mesher/surface_io.h"
 
 #include <vtkCellArray.h>
-#include <vtkLogger.h>
 #include <vtkNew.h>
-#include <vtkOutputWindow.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkSmartPointer.h>
 #include <vtkTriangleFilter.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -36,6 +33,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/paths.h"
+#include "mesher/vtk_messages.h"
 
 namespace hexbite {
 
@@ -674,60 +672,6 @@ TriSurface read_ply(const std::string& path) {
 // ------------------------------------------------------------------------------------------------
 // VTP through VTK.
 
-// Collects VTK's error and warning texts instead of letting them go to the terminal, so that a bad
-// file ends in one InputError with VTK's explanation inside it.
-class CapturingOutputWindow : public vtkOutputWindow {
- public:
-  static CapturingOutputWindow* New();
-  vtkTypeMacro(CapturingOutputWindow, vtkOutputWindow);
-  void DisplayText(const char* text) override { add(text); }
-  void DisplayErrorText(const char* text) override { add(text); }
-  void DisplayWarningText(const char* text) override { add(text); }
-  void DisplayGenericWarningText(const char* text) override { add(text); }
-  void DisplayDebugText(const char*) override {}
-  std::string messages;
-
- private:
-  // VTK's text is "ERROR: In file.cxx, line N\nClass (0x...): explanation\n\n"; keep the explanation,
-  // and drop the pipeline's follow-up "returned failure for request" which says nothing new.
-  void add(const char* text) {
-    if (!text) return;
-    std::string t(text);
-    if (t.rfind("ERROR: In ", 0) == 0 || t.rfind("Warning: In ", 0) == 0)
-      t = t.substr(std::min(t.size(), t.find('\n') + 1));
-    if (const std::size_t object = t.find("): "); object != std::string::npos) t = t.substr(object + 3);
-    t = t.substr(0, t.find('\n'));
-    if (t.empty() || t.find("returned failure for request") != std::string::npos) return;
-    if (!messages.empty()) messages += "; ";
-    messages += t;
-  }
-};
-vtkStandardNewMacro(CapturingOutputWindow);
-
-// Routes VTK's messages into a CapturingOutputWindow for the lifetime of the object. VTK 9 also
-// logs every error through vtkLogger straight to standard error; that is switched off meanwhile.
-class ScopedVtkCapture {
- public:
-  ScopedVtkCapture()
-      : previous_(vtkOutputWindow::GetInstance()),
-        previous_verbosity_(vtkLogger::GetCurrentVerbosityCutoff()) {
-    vtkOutputWindow::SetInstance(capture_);
-    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
-  }
-  ~ScopedVtkCapture() {
-    vtkLogger::SetStderrVerbosity(previous_verbosity_);
-    vtkOutputWindow::SetInstance(previous_);
-  }
-  ScopedVtkCapture(const ScopedVtkCapture&) = delete;
-  ScopedVtkCapture& operator=(const ScopedVtkCapture&) = delete;
-  const std::string& messages() const { return capture_->messages; }
-
- private:
-  vtkSmartPointer<vtkOutputWindow> previous_;
-  vtkLogger::Verbosity previous_verbosity_;
-  vtkNew<CapturingOutputWindow> capture_;
-};
-
 // Copies VTK points into the soup, each checked to be finite.
 void copy_points(const std::string& path, vtkPoints* points, TriSurface& s) {
   const vtkIdType n = points ? points->GetNumberOfPoints() : 0;
@@ -757,7 +701,7 @@ void require_cells_in_range(const std::string& path, vtkCellArray* cells, vtkIdT
 }
 
 TriSurface read_vtp(const std::string& path) {
-  ScopedVtkCapture capture;
+  VtkMessageCapture capture;
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str()))
     throw InputError(
@@ -767,9 +711,10 @@ TriSurface read_vtp(const std::string& path) {
   reader->SetFileName(path.c_str());
   reader->Update();
   vtkPolyData* data = reader->GetOutput();
-  if (!capture.messages().empty() || !data)
+  // Warnings (for example about an unknown array type) do not make a file unreadable; errors do.
+  if (!capture.errors().empty() || !data)
     throw InputError(quoted(path) + " could not be read as VTP: " +
-                     (capture.messages().empty() ? std::string("no data") : capture.messages()) +
+                     (capture.errors().empty() ? std::string("no data") : capture.errors()) +
                      "; export it again");
   const vtkIdType n = data->GetNumberOfPoints();
   // Validate before triangulating: vtkTriangleFilter does not check point ids.
@@ -911,14 +856,14 @@ void write_vtp(const std::string& tmp_path, const TriSurface& s) {
   data->SetPoints(points);
   data->SetPolys(polys);
 
-  ScopedVtkCapture capture;
+  VtkMessageCapture capture;
   vtkNew<vtkXMLPolyDataWriter> writer;
   writer->SetFileName(tmp_path.c_str());
   writer->SetInputData(data);
   writer->SetDataModeToBinary();
   if (writer->Write() != 1)
     throw RunError("cannot write " + quoted(tmp_path) + ": " +
-                   (capture.messages().empty() ? std::string("VTK writer failed") : capture.messages()));
+                   (capture.errors().empty() ? std::string("VTK writer failed") : capture.errors()));
 }
 
 }  // namespace

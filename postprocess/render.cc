@@ -27,6 +27,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "mesher/vtk_messages.h"
 
 namespace hexbite {
 
@@ -151,11 +152,18 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
   if (!std::filesystem::is_regular_file(vtu_path))
     throw InputError("cannot read '" + vtu_path + "': no such file");
   vtkNew<vtkXMLUnstructuredGridReader> reader;
-  reader->SetFileName(vtu_path.c_str());
-  reader->Update();
-  vtkUnstructuredGrid* grid = reader->GetOutput();
-  if (reader->GetErrorCode() != 0 || grid == nullptr || grid->GetNumberOfCells() == 0)
-    throw InputError("cannot read '" + vtu_path + "' as a VTK unstructured grid (.vtu) with cells");
+  vtkUnstructuredGrid* grid = nullptr;
+  {
+    VtkMessageCapture capture;
+    if (reader->CanReadFile(vtu_path.c_str()) != 0) {
+      reader->SetFileName(vtu_path.c_str());
+      reader->Update();
+      grid = reader->GetOutput();
+    }
+    if (!capture.errors().empty() || grid == nullptr || grid->GetNumberOfCells() == 0)
+      throw InputError("cannot read '" + vtu_path + "' as a VTK unstructured grid (.vtu) with cells" +
+                       (capture.errors().empty() ? std::string() : " (VTK: " + capture.errors() + ")"));
+  }
 
   vtkNew<vtkDataSetSurfaceFilter> outer;  // only the boundary faces are visible
   outer->SetInputData(grid);

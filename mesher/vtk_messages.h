@@ -1,0 +1,31 @@
+#pragma once
+// What VTK's readers and writers print, captured so that it reaches the user inside one InputError or
+// RunError instead of as VTK's own multi-line, coloured log on the terminal.
+
+#include <memory>
+#include <string>
+
+namespace hexbite {
+
+// For its lifetime, routes VTK's global output window into this object and mutes the logger that VTK 9
+// also sends every error to (it prints to standard error by itself); both are restored afterwards. Not
+// thread-safe: VTK's output window is global, so use it around reading and writing files only.
+class VtkMessageCapture {
+ public:
+  VtkMessageCapture();
+  ~VtkMessageCapture();
+  VtkMessageCapture(const VtkMessageCapture&) = delete;
+  VtkMessageCapture& operator=(const VtkMessageCapture&) = delete;
+
+  // The explanations of the errors (warnings) seen so far, "; "-joined, without VTK's "ERROR: In file,
+  // line N" headers and "vtkClass (0x...): " prefixes, and without the pipeline's follow-up "returned
+  // failure for request", which says nothing new. Empty when there were none.
+  const std::string& errors() const;
+  const std::string& warnings() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hexbite
