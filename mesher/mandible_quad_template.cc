@@ -156,6 +156,7 @@ MandibleQuadTemplate mandible_quad_template() {
     key(side + "notch_back", sign * 5, 2, 1);
   }
   key("symphysis_top_buccal", 0, 1, 1);
+  key("symphysis_top_lingual", 0, 1, 0);  // with the one above: an edge through the bone (its chord's count)
   key("symphysis_bottom_buccal", 0, 0, 1);
 
   // The default dentate mandible's landmarks and insertions (hexbite generate mandible --landmarks, left

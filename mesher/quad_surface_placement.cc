@@ -338,13 +338,17 @@ std::map<std::string, Vec3> derive_points(const TriSurface& surface, const Mandi
 }
 
 // Per-chord subdivision counts n_c = max(1, round(L_c / h)) with h chosen so that the refined quad count
-// is closest to the target and even.
+// is closest to the target and even. A chord marked `odd` gets the odd count nearest to L_c / h, at least 3.
 std::vector<int> chord_counts(const std::vector<Chord>& chords, const std::vector<double>& chord_length,
-                              const std::vector<std::array<int, 2>>& quad_chords, int target) {
+                              const std::vector<std::array<int, 2>>& quad_chords, int target,
+                              const std::vector<char>& odd) {
   auto counts_for = [&](double h) {
     std::vector<int> n(chords.size());
-    for (std::size_t c = 0; c < chords.size(); ++c)
-      n[c] = std::max(1, static_cast<int>(std::lround(chord_length[c] / h)));
+    for (std::size_t c = 0; c < chords.size(); ++c) {
+      const double x = chord_length[c] / h;
+      n[c] = odd[c] ? std::max(3, 2 * static_cast<int>(std::lround((x - 1.0) / 2.0)) + 1)
+                    : std::max(1, static_cast<int>(std::lround(x)));
+    }
     return n;
   };
   auto total = [&](const std::vector<int>& n) {
@@ -360,12 +364,13 @@ std::vector<int> chord_counts(const std::vector<Chord>& chords, const std::vecto
   std::vector<int> n = counts_for(hi);
   if (std::abs(total(counts_for(lo)) - target) < std::abs(total(n) - target)) n = counts_for(lo);
   if (total(n) % 2 != 0) {
-    // The single +-1 change of one chord's count that makes the total even and closest to the target.
+    // The single +-1 change of one chord's count that makes the total even and closest to the target (the
+    // odd chords keep theirs).
     long best_dev = std::numeric_limits<long>::max();
     int best_c = -1, best_delta = 0;
     for (std::size_t c = 0; c < chords.size(); ++c)
       for (int delta : {-1, 1}) {
-        if (n[c] + delta < 1) continue;
+        if (odd[c] || n[c] + delta < 1) continue;
         n[c] += delta;
         const long t = total(n);
         n[c] -= delta;
@@ -989,7 +994,21 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   std::vector<std::array<int, 2>> quad_chords(macro.quads.size());
   for (std::size_t q = 0; q < macro.quads.size(); ++q)
     quad_chords[q] = {edge_chord[macro_edges.quad_edges[q][0]], edge_chord[macro_edges.quad_edges[q][1]]};
-  const std::vector<int> counts = chord_counts(chords, chord_length, quad_chords, options.target_quads);
+  // The chord through the bone (lingual to buccal) gets an odd count: with an even one a row of quad nodes
+  // runs along the mid-line of every rim, which on a thin rim is its crest (the real jaw's coronoid blade is
+  // 1.3 mm thick, its sigmoid notch rims about as thin). The quads there fold by about 124 degrees across
+  // the node and no pillow hex corner at it gets much above 0.3: with 2 quads through the bone the real
+  // jaw's mesh had a scaled Jacobian of 0.230 at the notch rims and coronoid tips, with 3 0.335
+  // (docs/mandible_quads.md). With an odd count a quad lies across the crest.
+  std::vector<char> odd(chords.size(), 0);
+  {
+    const int lingual = tmpl.key_nodes.at("symphysis_top_lingual"),
+              buccal = tmpl.key_nodes.at("symphysis_top_buccal");
+    for (std::size_t e = 0; e < macro_edges.edges.size(); ++e)
+      if (std::minmax(macro_edges.edges[e][0], macro_edges.edges[e][1]) == std::minmax(lingual, buccal))
+        odd[edge_chord[e]] = 1;
+  }
+  const std::vector<int> counts = chord_counts(chords, chord_length, quad_chords, options.target_quads, odd);
   std::vector<int> edge_count(macro_edges.edges.size());
   for (std::size_t e = 0; e < edge_count.size(); ++e) edge_count[e] = counts[edge_chord[e]];
 

@@ -168,7 +168,7 @@ TEST(MandibleQuads, ExtremePointsWithoutLandmarkFile) {
   EXPECT_EQ(r.matched_points.size(), 8u);
   EXPECT_TRUE(r.landmark_nodes.empty());
   EXPECT_EQ(r.folded_quads, 0);
-  EXPECT_LE(r.hausdorff_mm, 1.0);  // measured 0.989 (1.13 before the fidelity refinement)
+  EXPECT_LE(r.hausdorff_mm, 1.0);  // measured 0.991 (1.15 before the fidelity refinement)
   // The feature snapping (step 8) is what brings the condyle poles in (without the fidelity refinement,
   // which brings them in by itself too: 0.995 mm without snapping).
   MandibleQuadOptions no_snap;
@@ -176,13 +176,13 @@ TEST(MandibleQuads, ExtremePointsWithoutLandmarkFile) {
   no_snap.fidelity_rounds = 0;
   MandibleQuadReport n;
   expect_usable_ball(quad_surface_from_mandible(m.surface, nullptr, "", no_snap, &n));
-  EXPECT_GT(n.hausdorff_mm, 1.9);  // measured 1.98
+  EXPECT_GT(n.hausdorff_mm, 1.8);  // measured 1.86 (1.98 with 2 quads through the bone)
   EXPECT_EQ(n.folded_quads, 0);
   MandibleQuadOptions snap_only;
   snap_only.fidelity_rounds = 0;
   MandibleQuadReport o;
   expect_usable_ball(quad_surface_from_mandible(m.surface, nullptr, "", snap_only, &o));
-  EXPECT_LT(o.hausdorff_mm, n.hausdorff_mm - 0.7);  // measured 1.13 against 1.98
+  EXPECT_LT(o.hausdorff_mm, n.hausdorff_mm - 0.6) << o.hausdorff_mm;  // measured 1.15 against 1.86
   EXPECT_GT(o.hausdorff_mm, r.hausdorff_mm + 0.1);
   EXPECT_EQ(o.fidelity_rounds, 0);
   EXPECT_TRUE(o.ring_rungs.empty());
@@ -357,7 +357,7 @@ TEST(MandibleQuadsCli, MeshSheetsFromTheGeneratedMandibleIsValid) {
                 .exit_code,
             0);
   const auto j = expect_valid_sheet_mesh(dir + "/m.stl", dir + "/m.yaml", dir);
-  // Measured: 2,644 hexes, scaled Jacobian min 0.578 and mean 0.903, Hausdorff 2.43 mm after sliding.
+  // Measured: 2,606 hexes, scaled Jacobian min 0.595 and mean 0.904, Hausdorff 2.33 mm after sliding.
   EXPECT_GT(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.5);
   EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.895);
   EXPECT_LT(j["fidelity"]["hausdorff_mm"].get<double>(), 2.9);
@@ -367,10 +367,10 @@ TEST(MandibleQuadsCli, MeshSheetsFromTheRealJawIsValid) {
   const std::string dir = test::temp_dir();
   const auto j = expect_valid_sheet_mesh(test::shared_data("jaw/jaw_smooth.stl"),
                                          test::shared_data("jaw/landmarks.yaml"), dir);
-  // Measured: 2,220 hexes, scaled Jacobian min 0.243 and mean 0.847 (0.854 before the fidelity
-  // refinement), Hausdorff 3.18 mm after sliding.
-  EXPECT_GT(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.2);
-  EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.845);
+  // Measured: 1,852 hexes, scaled Jacobian min 0.335 and mean 0.856, Hausdorff 3.27 mm after sliding. With
+  // 2 quads through the bone (an even count: nodes on the crests of the thin rims) the minimum was 0.230.
+  EXPECT_GE(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.3);
+  EXPECT_GE(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.85);
   EXPECT_LT(j["fidelity"]["hausdorff_mm"].get<double>(), 4.0);
 }
 
