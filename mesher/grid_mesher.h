@@ -26,9 +26,11 @@
 //   5. steps 1-4 again on the grid shifted by half a cell, then by a quarter; the mesh with the fewest
 //      inverted hexes, then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept
 //      (with fine cells: the higher mean where both measures reach mean_tie_break). With fine cells four
-//      attempts: the plain core unshifted and shifted by half a cell, the thick-margin core shifted by half
-//      and by a quarter; where the best of them has a measure below 0.3, the three grids again with margin
-//      everywhere (attempts = 7);
+//      attempts: the regular core (the plain core, shallower where the solid is thick, with fewer
+//      irregular boundary vertices) unshifted, the plain core shifted by half a cell, the thick-margin core
+//      shifted by half and by a quarter; where the best of them has a measure below 0.3, the two
+//      shifted grids again with margin everywhere (attempts = 6); where another attempt reaches
+//      mean_tie_break but the regular core does not, the regular core on the other two grids (attempts = 6);
 //   6. on the kept mesh only, improve_mean_jacobian raises the mean scaled Jacobian without lowering that
 //      measure (boundary nodes sliding within worst_element_reach of where the pillow layer put them).
 // Cost: O(N) cells, O(N^(2/3)) segment queries for classification and a distance query per outside cell
@@ -72,13 +74,24 @@ struct GridMeshOptions {
   // (mesher/boundary_fit.h; report.volume_fit, a phase "volume fit"); off by default.
   bool fit_volume = false;
   // Fine cells: when the best attempt's min(scaled Jacobian, 3 / kappa) is below this (a defect, not a
-  // minimum merely short of 0.5), the grids are meshed again with margin everywhere (attempts = 7).
+  // minimum merely short of 0.5), the shifted grids are meshed again with margin everywhere (attempts = 6).
   double retry_below = 0.3;
   double thick_margin = -0.2;
+  // Fine cells: the first attempt's core is the regular core. It is the plain core (fine_margin) without
+  // the cells whose centre lies less than regular_margin * h inside the surface where the solid is at least
+  // regular_thin_cells cells thick (pillow hexes of more even thickness), then regularized: single boundary
+  // cells are removed (centre at most regular_inside * h inside) or added (centre at most
+  // regular_outside * h outside) where the solid is at least two cells thick, while that lowers the number
+  // of irregular core boundary vertices (valence other than 4), whose pillow hexes are the worst.
+  double regular_margin = 0.2;
+  double regular_thin_cells = 1.0;
+  double regular_inside = 0.4;
+  double regular_outside = 0.15;
   double thick_margin_cells = 3.0;
   // Grid positions, each a full run: unshifted, shifted by half a cell, by a quarter (1 to 3; with fine cells
-  // the plain core on the first two, the thick-margin core on all but the first). The mesh with the fewest
-  // inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is kept.
+  // the regular core on the first, the plain core on the second, the thick-margin core on all but the
+  // first). The mesh with the fewest inverted hexes, then the largest min(scaled Jacobian, 3 / kappa), is
+  // kept.
   int grids = 3;
   // Grids meshed at once, each in its own thread (1 to 4); the mesh does not depend on it.
   int threads = 2;
@@ -126,13 +139,17 @@ struct MeshFidelity {
 };
 
 struct GridMeshReport {
-  int attempts = 1;           // grids tried (GridMeshOptions::grids; with fine cells 4, or 7 with the retry)
+  // Grids tried (GridMeshOptions::grids; with fine cells 4, or 6 with the mean or the defect retry).
+  int attempts = 1;
   double cell_size = 0;       // h, mm (this and the fields below describe the kept grid)
   std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;
   int pillow_hexes = 0;
   int cells_added_for_manifold = 0;
   int cells_in_dropped_components = 0;
+  // Vertices of the core's boundary quad surface, and those of valence other than 4 among them.
+  int core_boundary_vertices = 0;
+  int irregular_core_boundary_vertices = 0;
   OptimizeReport optimize;
   std::optional<BoundaryFitReport> volume_fit;  // with GridMeshOptions::fit_volume and no inverted hex
   MeshFidelity fidelity;
