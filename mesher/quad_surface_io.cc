@@ -169,7 +169,8 @@ QuadSurface from_polydata(const std::string& path, vtkPolyData* poly) {
   return s;
 }
 
-// A reader's error code says a file is broken; VTK's captured explanation says how.
+// A reader's error code or an error it printed says a file is broken (the XML reader reports a cut-off file
+// only by printing); VTK's captured explanation says how.
 std::string vtk_explanation(const VtkMessageCapture& capture) {
   return capture.errors().empty() ? std::string() : " (VTK: " + capture.errors() + ")";
 }
@@ -181,7 +182,7 @@ QuadSurface read_vtp(const std::string& path) {
     throw InputError(quoted(path) + " is not a VTK XML polydata (.vtp) file");
   reader->SetFileName(path.c_str());
   reader->Update();
-  if (reader->GetErrorCode() != 0)
+  if (reader->GetErrorCode() != 0 || !capture.errors().empty())
     throw InputError(quoted(path) + " could not be read as VTK XML polydata (truncated or corrupt file" +
                      vtk_explanation(capture) + ")");
   return from_polydata(path, reader->GetOutput());
@@ -194,7 +195,7 @@ QuadSurface read_legacy_vtk(const std::string& path) {
   if (!reader->IsFilePolyData())
     throw InputError(quoted(path) + " is not a legacy VTK polydata file (DATASET POLYDATA)");
   reader->Update();
-  if (reader->GetErrorCode() != 0)
+  if (reader->GetErrorCode() != 0 || !capture.errors().empty())
     throw InputError(quoted(path) + " could not be read as legacy VTK polydata (truncated or corrupt file" +
                      vtk_explanation(capture) + ")");
   return from_polydata(path, reader->GetOutput());

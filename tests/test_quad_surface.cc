@@ -168,6 +168,25 @@ TEST(QuadSurfaceIo, LegacyVtkPolydata) {
   EXPECT_NE(e.find("face 1 (0-based) has 3 corners"), std::string::npos) << e;
 }
 
+// A cut-off XML file: VTK's reader reports it only by printing, and that explanation is the error's reason.
+TEST(QuadSurfaceIo, CutOffVtpGivesVtksReason) {
+  const std::string dir = test::temp_dir();
+  const std::string vtp =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      "<PolyData><Piece NumberOfPoints=\"4\" NumberOfPolys=\"1\">\n"
+      "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 1 1 0 0 1 0"
+      "</DataArray></Points>\n"
+      "<Polys><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3</DataArray>"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">4</DataArray></Polys>\n"
+      "</Piece></PolyData>\n</VTKFile>\n";
+  test::write_file(dir + "/q.vtp", vtp);
+  ASSERT_EQ(read_quad_surface(dir + "/q.vtp").quads.size(), 1u);
+  test::write_file(dir + "/cut.vtp", vtp.substr(0, vtp.size() / 2));
+  const std::string e = error_of(dir + "/cut.vtp");
+  EXPECT_NE(e.find("'" + dir + "/cut.vtp' could not be read as VTK XML polydata"), std::string::npos) << e;
+  EXPECT_NE(e.find("(VTK: Error parsing XML"), std::string::npos) << e;
+}
+
 TEST(QuadCheckCli, ExitCodesAndMessages) {
   const std::string dir = test::temp_dir();
   write_quad_obj(dir + "/block.obj", test::block_surface(2, 3, 4));
