@@ -185,8 +185,8 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   vtkUnstructuredGrid* grid = reader->GetOutput();
   // Warnings (for example about an unknown array type) do not make a file unreadable; errors do.
   if (!capture.errors().empty() || grid == nullptr)
-    throw InputError("cannot read " + where + ": the file is damaged or truncated (VTK: " +
-                     (capture.errors().empty() ? std::string("no output") : capture.errors()) + ")");
+    throw InputError("cannot read " + where + ": the file is damaged or truncated" +
+                     (capture.errors().empty() ? std::string(" (VTK: no output)") : capture.reason()));
   const vtkIdType num_points = grid->GetNumberOfPoints();
   const vtkIdType num_cells = grid->GetNumberOfCells();
   if (num_points > std::numeric_limits<int>::max() || num_cells > std::numeric_limits<int>::max())

@@ -171,10 +171,6 @@ QuadSurface from_polydata(const std::string& path, vtkPolyData* poly) {
 
 // A reader's error code or an error it printed says a file is broken (the XML reader reports a cut-off file
 // only by printing); VTK's captured explanation says how.
-std::string vtk_explanation(const VtkMessageCapture& capture) {
-  return capture.errors().empty() ? std::string() : " (VTK: " + capture.errors() + ")";
-}
-
 QuadSurface read_vtp(const std::string& path) {
   VtkMessageCapture capture;
   vtkNew<vtkXMLPolyDataReader> reader;
@@ -184,7 +180,7 @@ QuadSurface read_vtp(const std::string& path) {
   reader->Update();
   if (reader->GetErrorCode() != 0 || !capture.errors().empty())
     throw InputError(quoted(path) + " could not be read as VTK XML polydata (truncated or corrupt file" +
-                     vtk_explanation(capture) + ")");
+                     capture.reason() + ")");
   return from_polydata(path, reader->GetOutput());
 }
 
@@ -197,7 +193,7 @@ QuadSurface read_legacy_vtk(const std::string& path) {
   reader->Update();
   if (reader->GetErrorCode() != 0 || !capture.errors().empty())
     throw InputError(quoted(path) + " could not be read as legacy VTK polydata (truncated or corrupt file" +
-                     vtk_explanation(capture) + ")");
+                     capture.reason() + ")");
   return from_polydata(path, reader->GetOutput());
 }
 

@@ -29,13 +29,12 @@ class CapturingOutputWindow : public vtkOutputWindow {
  public:
   static CapturingOutputWindow* New();
   vtkTypeMacro(CapturingOutputWindow, vtkOutputWindow);
-  void DisplayText(const char* text) override { append_explanation(warnings, text); }
+  void DisplayText(const char*) override {}
   void DisplayErrorText(const char* text) override { append_explanation(errors, text); }
-  void DisplayWarningText(const char* text) override { append_explanation(warnings, text); }
-  void DisplayGenericWarningText(const char* text) override { append_explanation(warnings, text); }
+  void DisplayWarningText(const char*) override {}
+  void DisplayGenericWarningText(const char*) override {}
   void DisplayDebugText(const char*) override {}
   std::string errors;
-  std::string warnings;
 };
 vtkStandardNewMacro(CapturingOutputWindow);
 
@@ -62,8 +61,8 @@ VtkMessageCapture::~VtkMessageCapture() {
 const std::string& VtkMessageCapture::errors() const {
   return impl_->capture->errors;
 }
-const std::string& VtkMessageCapture::warnings() const {
-  return impl_->capture->warnings;
+std::string VtkMessageCapture::reason() const {
+  return errors().empty() ? std::string() : " (VTK: " + errors() + ")";
 }
 
 }  // namespace hexbite

@@ -17,11 +17,13 @@ class VtkMessageCapture {
   VtkMessageCapture(const VtkMessageCapture&) = delete;
   VtkMessageCapture& operator=(const VtkMessageCapture&) = delete;
 
-  // The explanations of the errors (warnings) seen so far, "; "-joined, without VTK's "ERROR: In file,
-  // line N" headers and "vtkClass (0x...): " prefixes, and without the pipeline's follow-up "returned
-  // failure for request", which says nothing new. Empty when there were none.
+  // The explanations of the errors seen so far, "; "-joined, without VTK's "ERROR: In file, line N" headers
+  // and "vtkClass (0x...): " prefixes, and without the pipeline's follow-up "returned failure for request",
+  // which says nothing new. Empty when there were none. (Warnings are swallowed: they do not make a file
+  // unreadable.)
   const std::string& errors() const;
-  const std::string& warnings() const;
+  // " (VTK: <errors>)" to append to a message, or "" when there were none.
+  std::string reason() const;
 
  private:
   struct Impl;

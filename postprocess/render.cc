@@ -162,7 +162,7 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
     }
     if (!capture.errors().empty() || grid == nullptr || grid->GetNumberOfCells() == 0)
       throw InputError("cannot read '" + vtu_path + "' as a VTK unstructured grid (.vtu) with cells" +
-                       (capture.errors().empty() ? std::string() : " (VTK: " + capture.errors() + ")"));
+                       capture.reason());
   }
 
   vtkNew<vtkDataSetSurfaceFilter> outer;  // only the boundary faces are visible
