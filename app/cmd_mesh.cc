@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/count_option.h"
 #include "app/mesh_sheets.h"
 #include "app/mesh_sheets_surface.h"
 #include "common/error.h"
@@ -172,9 +173,6 @@ void run_mesh(const MeshOptions& o) {
   if (o.method == "sheets")
     return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
-  if (o.target < kMinTarget || o.target > kMaxTarget)
-    throw InputError("--target-hexes " + std::to_string(o.target) + " is out of range: give a number from " +
-                     std::to_string(kMinTarget) + " to " + std::to_string(kMaxTarget));
   const double scale = unit_to_mm(o.units);
   const TriSurface surface = load_closed_surface(o.surface, scale);
   std::unique_ptr<Landmarks> landmarks;
@@ -233,7 +231,9 @@ void add_mesh_command(CLI::App& app) {
          "Meshing method: grid (overlay grid + pillow layer) or sheets (cycle elimination of --quad-surface, "
          "or of the mandible quad template placed on the SURFACE)")
       ->check(CLI::IsMember({"grid", "sheets"}));
-  cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")->default_val(2500);
+  cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")
+      ->default_val(2500)
+      ->transform(count_in_range(kMinTarget, kMaxTarget));
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required();
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   CLI::Option* margin =

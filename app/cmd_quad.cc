@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/count_option.h"
 #include "app/mesh_sheets_surface.h"
 #include "common/error.h"
 #include "common/progress.h"
@@ -157,7 +158,8 @@ void add_quad_commands(CLI::App& app) {
       "--landmarks", from->landmarks,
       "Landmark file (.yaml) in the surface's frame; without it extreme points place the template");
   fm->add_option("--target-quads", from->target_quads, "Wanted number of quads (24 to 200,000)")
-      ->default_val(1300);
+      ->default_val(1300)
+      ->transform(count_in_range(24, 200000));
   fm->add_option("--units", from->units, "Length unit of the surface and landmark files: mm, cm or m")
       ->default_val("mm");
   fm->add_option("-o,--output", from->output, "Output quad surface (.obj)")->required();

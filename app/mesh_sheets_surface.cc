@@ -220,9 +220,6 @@ void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
 }
 
 void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
-  if (o.target_hexes < 8 || o.target_hexes > 5000000)
-    throw InputError("--target-hexes " + std::to_string(o.target_hexes) +
-                     " is out of range: give a number from 8 to 5,000,000");
   const auto t0 = std::chrono::steady_clock::now();
   const MandibleQuadCommandOptions& qo = o.quad;
   MandibleSheetOptions options;

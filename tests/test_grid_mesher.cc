@@ -451,6 +451,19 @@ TEST(MeshCommand, RejectsBadTargetsMethodAndOpenSurfaces) {
   EXPECT_NE(r.err.find("out of range"), std::string::npos) << r.err;
   r = test::run_hexbite({"mesh", dir + "/sphere.stl", "--target-hexes", "6000000", "-o", dir + "/m.vtu"});
   EXPECT_EQ(r.exit_code, 2);
+  // Scientific notation is a count too; out of range it gets the range, not CLI11's "Could not convert".
+  r = test::run_hexbite({"mesh", dir + "/sphere.stl", "--target-hexes", "1e12", "-o", dir + "/m.vtu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("1e12 is out of range: give a whole number from 8 to 5,000,000"), std::string::npos)
+      << r.err;
+  r = test::run_hexbite({"mesh", dir + "/sphere.stl", "--target-hexes", "250.5", "-o", dir + "/m.vtu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("250.5 is not a whole number"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::ifstream(dir + "/m.vtu").good());
+  r = test::run_hexbite(
+      {"mesh", dir + "/sphere.stl", "--target-hexes", "5e2", "--json", "--quiet", "-o", dir + "/s.vtu"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("target_hexes"), 500);
   // An unknown method (--method sheets exists now and is tested with cycle elimination).
   r = test::run_hexbite({"mesh", dir + "/sphere.stl", "--method", "octree", "-o", dir + "/m.vtu"});
   EXPECT_EQ(r.exit_code, 2);
