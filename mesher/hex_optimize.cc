@@ -372,36 +372,45 @@ bool ascent_step(HexMesh& mesh, int v, double h, bool sliding, const SurfaceProj
   return false;
 }
 
+// What a worst-element visit raises: the corners' scaled Jacobians (stage 2), both measures (stage 1), or
+// their 3 / kappa (the condition stage).
+enum class Raise { kScaledJacobian, kBoth, kCondition };
+
 // One worst-element visit of node v: ascent on the soft minimum S(p) = -(1/mu) log sum exp(-mu m_i(p))
-// of the measures m_i of the corners that depend on p (scaled Jacobian and 3 / kappa with `with_kappa`,
-// else the scaled Jacobian alone), with the untangler's damped Gauss-Newton model of its Hessian
-// (ascent_step). A step is accepted only when the true minimum of the m_i grows and no corner's 3 / kappa
-// falls below the smaller of its old minimum and `q_floor`. Returns true when the node moved.
+// of the measures m_i of the corners that depend on p (`what`), with the untangler's damped Gauss-Newton
+// model of its Hessian (ascent_step). A step is accepted only when the true minimum of the m_i grows, no
+// corner's 3 / kappa falls below the smaller of its old minimum and `q_floor`, and (kCondition) the
+// smallest of both measures does not fall. Returns true when the node moved.
 bool raise_worst_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool sliding,
-                      const SurfaceProjector* surface, const Vec3& home, double reach, bool with_kappa,
-                      double q_floor, std::vector<CornerRef>& corners) {
+                      const SurfaceProjector* surface, const Vec3& home, double reach, Raise what,
+                      double q_floor, double mu, std::vector<CornerRef>& corners) {
   corners_of_node(mesh, adj, v, corners);
   if (corners.empty()) return false;
-  const double mu = 30.0;
   bool moved = false;
   for (int iter = 0; iter < 4; ++iter) {
     const std::size_t n = corners.size();
     std::vector<double> m;
     std::vector<Eigen::Vector3d> g;
-    double mmin = kInf, qmin = kInf;
+    double smin = kInf, qmin = kInf;
     for (std::size_t i = 0; i < n; ++i) {
       double sj, q;
       Vec3 gs, gq;
       corner_measures(mesh, corners[i].hex, corners[i].corner, v, sj, gs, q, gq);
-      m.push_back(sj);
-      g.push_back(Eigen::Vector3d(gs[0], gs[1], gs[2]) * h);  // per unit of the edge length
-      if (with_kappa) {
+      if (what != Raise::kCondition) {
+        m.push_back(sj);
+        g.push_back(Eigen::Vector3d(gs[0], gs[1], gs[2]) * h);  // per unit of the edge length
+      }
+      if (what != Raise::kScaledJacobian) {
         m.push_back(q);
         g.push_back(Eigen::Vector3d(gq[0], gq[1], gq[2]) * h);
       }
-      mmin = std::min(mmin, with_kappa ? std::min(sj, q) : sj);
+      smin = std::min(smin, sj);
       qmin = std::min(qmin, q);
     }
+    const double mmin = what == Raise::kScaledJacobian ? smin
+                        : what == Raise::kBoth         ? std::min(smin, qmin)
+                                                       : qmin;
+    const double both_min = std::min(smin, qmin);
     const double q_limit = std::min(qmin, q_floor);
     double z = 0.0;
     std::vector<double> w(m.size());
@@ -414,7 +423,16 @@ bool raise_worst_node(HexMesh& mesh, const Adjacency& adj, int v, double h, bool
     const bool accepted = ascent_step(mesh, v, h, sliding, surface, home, reach, grad, neg_hess, [&] {
       double s_new, q_new;
       corner_measures_min(mesh, corners, v, s_new, q_new);
-      return (with_kappa ? std::min(s_new, q_new) : s_new) > mmin + 1e-6 && q_new >= q_limit;
+      if (q_new < q_limit) return false;
+      switch (what) {
+        case Raise::kScaledJacobian:
+          return s_new > mmin + 1e-6;
+        case Raise::kBoth:
+          return std::min(s_new, q_new) > mmin + 1e-6;
+        case Raise::kCondition:
+          return q_new > mmin + 1e-6 && std::min(s_new, q_new) >= both_min;
+      }
+      return false;
     });
     if (!accepted) break;
     moved = true;
@@ -795,8 +813,8 @@ int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, cons
   const std::vector<double> h = local_edge_length(mesh, adj);
   const std::vector<Vec3> home = home_in ? *home_in : mesh.vertices;
   // Per hex the measure of the stage (the smaller of the scaled Jacobian and 3 / kappa, or the scaled
-  // Jacobian alone), and the mesh's smallest 3 / kappa.
-  std::vector<double> worst(mesh.hexes.size());
+  // Jacobian alone) and 3 / kappa, and the mesh's smallest 3 / kappa.
+  std::vector<double> worst(mesh.hexes.size()), q_hex(mesh.hexes.size());
   double q_floor = kInf;
   auto measure = [&](bool with_kappa) {
     q_floor = kInf;
@@ -804,13 +822,43 @@ int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, cons
       Vec3 p[8];
       for (int i = 0; i < 8; ++i) p[i] = mesh.vertices[mesh.hexes[e][i]];
       const HexQuality q = hex_quality(p);
-      worst[e] = with_kappa ? std::min(q.scaled_jacobian, 3.0 / q.condition) : q.scaled_jacobian;
-      q_floor = std::min(q_floor, 3.0 / q.condition);
+      q_hex[e] = 3.0 / q.condition;
+      worst[e] = with_kappa ? std::min(q.scaled_jacobian, q_hex[e]) : q.scaled_jacobian;
+      q_floor = std::min(q_floor, q_hex[e]);
     }
   };
   std::vector<CornerRef> corners;
   Progress progress("worst elements");
   int sweeps = 0;
+  // Sweeps visiting the nodes of the hexes whose `key` is below `limit`, lowest first (ties by index), each
+  // node once per sweep, until a sweep moves no node; returns after max_sweeps.
+  auto visit_below = [&](const std::vector<double>& key, double limit, int max_sweeps, Raise what,
+                         double reach, double mu, const char* label) {
+    const bool with_kappa = what != Raise::kScaledJacobian;
+    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+      std::vector<int> bad;
+      for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+        if (key[e] < limit) bad.push_back(static_cast<int>(e));
+      if (bad.empty()) break;
+      std::stable_sort(bad.begin(), bad.end(), [&](int a, int b) { return key[a] < key[b]; });
+      std::vector<char> seen(mesh.vertices.size(), 0);
+      bool moved = false;
+      for (int e : bad)
+        for (int v : mesh.hexes[e]) {
+          if (seen[v] || !movable[v]) continue;
+          seen[v] = 1;
+          const bool slides = surface != nullptr && !sliding.empty() && sliding[v] != 0;
+          moved = raise_worst_node(mesh, adj, v, h[v], slides, surface, home[v], reach * h[v], what,
+                                   with_kappa ? 0.0 : q_floor, mu, corners) ||
+                  moved;
+        }
+      ++sweeps;
+      measure(with_kappa);
+      progress.update(double(sweep + 1) / max_sweeps,
+                      std::string(label) + ", sweep " + std::to_string(sweep + 1));
+      if (!moved) break;
+    }
+  };
   // The first stage raises both measures of the hexes below the threshold; the second the scaled Jacobian
   // of every hex, with no corner's 3 / kappa falling below the mesh's smallest.
   // The stages repeat worst_element_rounds times: the second stage moves nodes that then give the first
@@ -821,31 +869,15 @@ int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, cons
     const double threshold = with_kappa ? options.worst_element_threshold : 1.0;
     const int max_sweeps = with_kappa ? options.worst_element_sweeps : options.scaled_jacobian_sweeps;
     measure(with_kappa);
-    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
-      // Visit the nodes of the hexes below the threshold, worst hex first (ties by index).
-      std::vector<int> bad;
-      for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-        if (worst[e] < threshold) bad.push_back(static_cast<int>(e));
-      if (bad.empty()) break;
-      std::stable_sort(bad.begin(), bad.end(), [&](int a, int b) { return worst[a] < worst[b]; });
-      std::vector<char> seen(mesh.vertices.size(), 0);
-      bool moved = false;
-      for (int e : bad)
-        for (int v : mesh.hexes[e]) {
-          if (seen[v] || !movable[v]) continue;
-          seen[v] = 1;
-          const bool slides = surface != nullptr && !sliding.empty() && sliding[v] != 0;
-          moved = raise_worst_node(mesh, adj, v, h[v], slides, surface, home[v],
-                                   options.worst_element_reach * h[v], with_kappa, with_kappa ? 0.0 : q_floor,
-                                   corners) ||
-                  moved;
-        }
-      ++sweeps;
-      measure(with_kappa);
-      progress.update(double(sweep + 1) / max_sweeps,
-                      "stage " + std::to_string(stage + 1) + ", sweep " + std::to_string(sweep + 1));
-      if (!moved) break;
-    }
+    visit_below(worst, threshold, max_sweeps, with_kappa ? Raise::kBoth : Raise::kScaledJacobian,
+                options.worst_element_reach, 30.0, with_kappa ? "stage 1" : "stage 2");
+    // The condition stage: stage 1's soft minimum (mu = 30) weighs every corner within about 0.03 of the
+    // smallest measure, and where a few hexes of nearly equal kappa share their nodes (pillow hexes on a
+    // thin plate) its ascent stalls above the target; a sharp minimum (mu = 400) of 3 / kappa alone follows
+    // the worst corner, and min(scaled Jacobian, 3 / kappa) around a node still never falls.
+    if (with_kappa && options.condition_target > 0.0)
+      visit_below(q_hex, 3.0 / options.condition_target, options.worst_element_sweeps, Raise::kCondition,
+                  options.condition_reach, 400.0, "condition stage");
   }
   progress.finish(std::to_string(sweeps) + " sweeps");
   return sweeps;
@@ -861,13 +893,14 @@ int improve_mean_jacobian(HexMesh& mesh, const std::vector<char>& movable, const
   const Adjacency adj(mesh);
   const std::vector<double> h = local_edge_length(mesh, adj);
   const std::vector<Vec3> home = home_in ? *home_in : mesh.vertices;
-  // No hex may fall below the larger of the mesh's smallest scaled Jacobian and the worst-element
-  // threshold (nor below its own value where that is lower), no corner's 3 / kappa below the mesh's
-  // smallest: the mesh's worst values never get worse.
+  // No hex may fall below the larger of the mesh's smallest scaled Jacobian and the floor
+  // (mean_jacobian_floor, or the worst-element threshold where that is negative; nor below its own value
+  // where that is lower), no corner's 3 / kappa below the mesh's smallest: the mesh's worst values never get
+  // worse.
   const HexQualityField field = compute_hex_quality(mesh);
-  const double sj_floor =
-      std::max(options.worst_element_threshold,
-               *std::min_element(field.scaled_jacobian.begin(), field.scaled_jacobian.end()));
+  const double sj_floor = std::max(
+      options.mean_jacobian_floor < 0.0 ? options.worst_element_threshold : options.mean_jacobian_floor,
+      *std::min_element(field.scaled_jacobian.begin(), field.scaled_jacobian.end()));
   const double q_floor = 3.0 / *std::max_element(field.condition.begin(), field.condition.end());
   Progress progress("mean scaled Jacobian");
   int sweeps = 0;

@@ -28,12 +28,15 @@
 //      so the mesh's smallest min(scaled Jacobian, 3 / kappa) never falls. Then a few sweeps over every
 //      node raise the scaled Jacobian alone, no corner's condition number growing beyond the mesh's
 //      largest. Boundary nodes slide, never to a point farther from where the optimization found them
-//      than worst_element_reach of an edge or than they already are. Both stages repeat
-//      worst_element_rounds times;
+//      than worst_element_reach of an edge or than they already are. Optionally
+//      (OptimizeOptions::condition_target), after the first stage a condition stage: the nodes of the hexes
+//      whose kappa is above the target ascend a sharp soft minimum of the 3 / kappa of the corners around
+//      them, never lowering the smallest of both measures there. Both stages (and the condition stage)
+//      repeat worst_element_rounds times;
 //   5. optionally (OptimizeOptions::mean_jacobian_sweeps), sweeps raising the mean element scaled Jacobian:
 //      each node ascends the sum of soft minima of the corner scaled Jacobians of its hexes, no hex falling
-//      below max(the mesh's smallest, worst_element_threshold) or its own value, no condition number
-//      beyond the mesh's largest, boundary nodes sliding as in phase 4.
+//      below max(the mesh's smallest, mean_jacobian_floor or else worst_element_threshold) or its own
+//      value, no condition number beyond the mesh's largest, boundary nodes sliding as in phase 4.
 // Cost: one sweep is O(m) for m hexes (each corner is evaluated a few times per node that it depends on);
 // the jaw at 2,500 hexes converges in about 70 sweeps (about 55 with reactivate = 0.01); each boundary
 // trial costs one closest-point query, O(log t) for t surface triangles, started from the node's current
@@ -78,10 +81,21 @@ struct OptimizeOptions {
   int scaled_jacobian_sweeps = 0;
   // Both stages of the pass run this many times in turn (the second stage's moves give the first room).
   int worst_element_rounds = 1;
+  // After stage 1 (each round), the condition stage: the nodes of the hexes whose condition number (cube =
+  // 3) is above this, worst hex first, ascend a sharp soft minimum (mu = 400 where stage 1 uses 30) of the
+  // 3 / kappa of the corners that depend on them, a step accepted only when the smallest of those grows and
+  // the smallest of both measures there does not fall; sliding nodes stay within condition_reach of an edge
+  // from home; at most worst_element_sweeps sweeps (0 = no such stage; needs worst_element_threshold).
+  // Stage 2 and the mean stage then keep the lower largest kappa as their cap.
+  double condition_target = 0.0;
+  double condition_reach = 1.2;
   // Last, sweeps over every node raising the sum of the element scaled Jacobians (each hex's smallest
   // corner value, whose mean the quality report gives) of the hexes around it (improve_mean_jacobian;
   // 0 = none).
   int mean_jacobian_sweeps = 0;
+  // No hex falls below the smaller of its own value and max(this, the mesh's smallest scaled Jacobian) in
+  // the mean stage (negative: worst_element_threshold).
+  double mean_jacobian_floor = -1.0;
 };
 
 // One row of the per-phase table.
@@ -125,8 +139,8 @@ int untangle(HexMesh& mesh, const std::vector<char>& movable, const std::vector<
 int optimize_condition(HexMesh& mesh, const std::vector<char>& movable, const std::vector<char>& sliding,
                        const SurfaceProjector* surface, const OptimizeOptions& options,
                        int* rounds = nullptr);
-// The worst-element pass (phase 4) on a valid mesh, both stages, worst_element_rounds times; returns the
-// number of sweeps. Does
+// The worst-element pass (phase 4) on a valid mesh, both stages (and the condition stage with
+// options.condition_target), worst_element_rounds times; returns the number of sweeps. Does
 // nothing when a hex is inverted or options.worst_element_threshold is not positive.
 // Sliding nodes never step farther from `home` (default: where the pass finds them) than
 // options.worst_element_reach of an edge or than they already are; optimize_hex_mesh passes the positions on
@@ -138,7 +152,8 @@ int improve_worst_elements(HexMesh& mesh, const std::vector<char>& movable, cons
 // Phase 5 on a valid mesh (options.mean_jacobian_sweeps sweeps; does nothing when a hex is inverted):
 // each movable node in turn ascends the sum, over its hexes, of a soft minimum of each hex's eight corner
 // scaled Jacobians, a step accepted only when the sum of their element values grows, no hex falls below the
-// smaller of its value and max(mesh's smallest scaled Jacobian, options.worst_element_threshold), and no
+// smaller of its value and max(mesh's smallest scaled Jacobian, options.mean_jacobian_floor, or
+// options.worst_element_threshold where that floor is negative), and no
 // corner's condition number grows beyond the mesh's largest, so the mesh's worst values never get worse.
 // After the first sweep only the nodes of hexes in which a node moved are visited. Sliding nodes slide
 // within options.worst_element_reach of `home` as in improve_worst_elements. Returns the number of sweeps.
