@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/ct_surface.h"
@@ -129,10 +130,14 @@ void add_generate_commands(CLI::App& app) {
       "mandible", "The built-in CT-like adult mandible: surface (marching cubes), landmarks and CT volume");
   auto args = std::make_shared<GenerateArgs>();
   MandibleParameters& p = args->parameters;
-  cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")->required();
+  cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")
+      ->required()
+      ->check(output_surface_file());
   cmd->add_option("--landmarks", args->landmarks,
-                  "Landmark and muscle file to write (YAML); default: OUTPUT's name with .landmarks.yaml");
-  cmd->add_option("--ct", args->ct, "Also write the CT-like volume (.mha, .mhd, .nii, .nii.gz)");
+                  "Landmark and muscle file to write (YAML); default: OUTPUT's name with .landmarks.yaml")
+      ->check(output_file({".yaml", ".yml"}));
+  cmd->add_option("--ct", args->ct, "Also write the CT-like volume (.mha, .mhd, .nii, .nii.gz)")
+      ->check(output_file({".mha", ".mhd", ".nii", ".nii.gz"}));
   cmd->add_option("--variant", args->variant, "dentate, edentulous or atrophic (resorbed, low body)");
   cmd->add_option("--voxel", p.voxel_mm, "Voxel size of the CT-like grid in mm (0.25 to 1.5)");
   const char* zero = " (default: the variant's, see docs/mandible.md)";

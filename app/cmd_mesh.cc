@@ -20,9 +20,9 @@
 #include <sstream>
 
 #include "app/commands.h"
-#include "app/count_option.h"
 #include "app/mesh_sheets.h"
 #include "app/mesh_sheets_surface.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/boundary_fit.h"
@@ -234,7 +234,7 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")
       ->default_val(2500)
       ->transform(count_in_range(kMinTarget, kMaxTarget));
-  cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required();
+  cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required()->check(output_file({".vtu"}));
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   CLI::Option* margin =
       cmd->add_option("--margin", o->margin,

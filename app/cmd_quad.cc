@@ -14,8 +14,8 @@
 #include <sstream>
 
 #include "app/commands.h"
-#include "app/count_option.h"
 #include "app/mesh_sheets_surface.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/quad_check.h"
@@ -162,7 +162,9 @@ void add_quad_commands(CLI::App& app) {
       ->transform(count_in_range(24, 200000));
   fm->add_option("--units", from->units, "Length unit of the surface and landmark files: mm, cm or m")
       ->default_val("mm");
-  fm->add_option("-o,--output", from->output, "Output quad surface (.obj)")->required();
+  fm->add_option("-o,--output", from->output, "Output quad surface (.obj)")
+      ->required()
+      ->check(output_file({".obj"}));
   fm->add_flag("--json", from->json, "Print the report as one JSON object on standard output");
   add_refine_options(*fm, from->refine);
   fm->callback([from] { run_quad_from_mandible(*from); });

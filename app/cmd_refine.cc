@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/boundary_fit.h"
@@ -203,7 +204,7 @@ void add_refine_command(CLI::App& app) {
       "--surface", o->surface,
       "Closed surface the mesh fills (.stl .obj .ply .off .vtp); new boundary nodes are projected "
       "onto it. Without it the refinement is purely parametric");
-  cmd->add_option("-o,--output", o->output, "Refined mesh (.vtu)")->required();
+  cmd->add_option("-o,--output", o->output, "Refined mesh (.vtu)")->required()->check(output_file({".vtu"}));
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "After the refinement, move the new boundary nodes off the --surface until the boundary "

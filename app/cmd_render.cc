@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/paths.h"
 #include "common/progress.h"
 #include "mesher/surface_io.h"
@@ -21,7 +22,7 @@ void add_render_command(CLI::App& app) {
   auto args = std::make_shared<Args>();
   cmd->add_option("INPUT", args->input, "Surface file (STL, OBJ, PLY, OFF, VTP) or hex mesh / solution (VTU)")
       ->required();
-  cmd->add_option("-o,--output", args->output, "PNG file to write")->required();
+  cmd->add_option("-o,--output", args->output, "PNG file to write")->required()->check(output_file({".png"}));
   cmd->add_option("--units", args->units, "Length unit of a surface input: mm, cm or m");
   cmd->add_option("--field", args->field,
                   "VTU only: colour by this point array (e.g. von_mises, displacement)");

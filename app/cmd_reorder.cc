@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/hex_mesh_io.h"
@@ -160,7 +161,9 @@ void add_reorder_command(CLI::App& app) {
       "reorder",
       "Renumber hexes and nodes (breadth-first or reverse Cuthill-McKee) to shrink the matrix bandwidth");
   cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu)")->required();
-  cmd->add_option("-o,--output", o->output, "Reordered mesh (.vtu)")->required();
+  cmd->add_option("-o,--output", o->output, "Reordered mesh (.vtu)")
+      ->required()
+      ->check(output_file({".vtu"}));
   cmd->add_option(
          "--method", o->method,
          "bfs: breadth-first from a boundary hex (the seed paper's order); rcm: reverse Cuthill-McKee")

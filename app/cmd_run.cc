@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "app/run_outputs.h"
 #include "app/run_pipeline.h"
 #include "common/atomic_file.h"
@@ -81,7 +82,9 @@ void add_run_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "run", "Simulate a bite scenario: mesh, solve, validate by refinement, write results and VTU files");
   cmd->add_option("scenario", o->scenario, "Scenario file (.yaml), see docs/scenario-format.md")->required();
-  cmd->add_option("-o,--output", o->output, "Output folder (created if missing)")->required();
+  cmd->add_option("-o,--output", o->output, "Output folder (created if missing)")
+      ->required()
+      ->check(output_folder());
   cmd->add_option("--export", o->export_format, "Also write the model for another solver: inp (CalculiX)")
       ->check(CLI::IsMember({"inp"}));
   cmd->add_option(

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/surface_check.h"
@@ -167,7 +168,8 @@ void add_surface_check_command(CLI::App& surface) {
                   "Length unit of the file's coordinates: mm, cm or m (reports are in mm)")
       ->capture_default_str();
   cmd->add_option("-o,--output", options->output,
-                  "Write the repaired surface here (format from the extension), only when it is usable");
+                  "Write the repaired surface here (format from the extension), only when it is usable")
+      ->check(output_surface_file());
   cmd->callback([options] { run_check(*options); });
 }
 

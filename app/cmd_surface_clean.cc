@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/surface_check.h"
@@ -118,7 +119,8 @@ void add_surface_clean_command(CLI::App& surface) {
       "bound");
   cmd->add_option("IN", options->input, "Closed surface: .stl, .obj, .ply, .off or .vtp")->required();
   cmd->add_option("-o,--output", options->output, "Cleaned surface, in mm (format from the extension)")
-      ->required();
+      ->required()
+      ->check(output_surface_file());
   cmd->add_option("--min-angle", options->clean.min_angle_deg,
                   "Remove triangles with an angle below this, in degrees (0 to 30)")
       ->capture_default_str();

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/ct_surface.h"
@@ -64,7 +65,9 @@ void add_surface_from_ct_command(CLI::App& surface) {
   cmd->add_option("--threshold", args->threshold,
                   "Iso-value in the volume's units (e.g. Hounsfield units; the built-in mandible uses 620)")
       ->required();
-  cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")->required();
+  cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")
+      ->required()
+      ->check(output_surface_file());
   cmd->callback([args] { run_from_ct(*args); });
 }
 

@@ -216,5 +216,36 @@ TEST(CliBadInput, OutOfRangeIndexAndMalformedLine) {
                   "line 5: malformed OFF line '0 one 0'");
 }
 
+// Output paths are checked while the command line is parsed, before any work: a folder, a missing folder or
+// a name whose extension the command does not write is exit 2 with the reason, and nothing is written
+// (before, `mesh -o x.txt` wrote a VTU into x.txt and `mesh -o /tmp` meshed and then failed with "Success").
+TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
+  const std::string dir = temp_dir();
+  const std::string cube = write_case("cube.obj", cube_obj());
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"mesh", cube, "-o", dir}, "is a folder: give a file name in it"},
+      {{"mesh", cube, "-o", dir + "/mesh.txt"}, "this command writes .vtu"},
+      {{"mesh", cube, "-o", dir + "/none/mesh.vtu"}, "folder '" + dir + "/none' does not exist"},
+      {{"quad", "from-mandible", cube, "-o", dir + "/q.vtp"}, "this command writes .obj"},
+      {{"surface", "clean", cube, "-o", dir + "/c.xyz"}, "writes .stl, .obj, .ply, .off or .vtp"},
+      {{"generate", "mandible", "-o", dir + "/g.stl", "--ct", dir + "/g.raw"},
+       "writes .mha, .mhd, .nii or .nii.gz"},
+      {{"run", "scenario.yaml", "-o", cube}, "is a file, not a folder"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  }
+  // No output and no temporary file.
+  EXPECT_TRUE(fs::is_empty(dir));
+  // Any case of the extension is fine.
+  EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
+}
+
 }  // namespace
 }  // namespace hexbite

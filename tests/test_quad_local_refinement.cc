@@ -313,8 +313,9 @@ TEST(QuadLocalRefinement, CommandLineRefusesUnknownNamesAndGrid) {
       {"mesh", jaw, "--method", "grid", "-o", test::temp_dir() + "/m.vtu", "--refine-at", "1,2,3"});
   EXPECT_EQ(grid.exit_code, 2);
   EXPECT_NE(grid.err.find("--refine-at refines the quad surface"), std::string::npos) << grid.err;
-  const test::CommandResult levels = test::run_hexbite(
-      {"mesh", jaw, "--method", "sheets", "-o", out, "--refine-at", "1,2,3", "--refine-levels", "9"});
+  const test::CommandResult levels =
+      test::run_hexbite({"mesh", jaw, "--method", "sheets", "-o", test::temp_dir() + "/m.vtu", "--refine-at",
+                         "1,2,3", "--refine-levels", "9"});
   EXPECT_EQ(levels.exit_code, 2);
   EXPECT_NE(levels.err.find("--refine-levels"), std::string::npos) << levels.err;
 }

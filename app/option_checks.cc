@@ -1,0 +1,96 @@
+#include "app/option_checks.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+
+// 5000000 -> "5,000,000", as the option descriptions write counts.
+std::string thousands(long n) {
+  std::string digits = std::to_string(n);
+  for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3)
+    digits.insert(static_cast<std::size_t>(i), ",");
+  return digits;
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// ".vtu" or ".stl, .obj or .ply".
+std::string listed(const std::vector<std::string>& extensions) {
+  std::string text;
+  for (std::size_t i = 0; i < extensions.size(); ++i)
+    text += (i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ") + extensions[i];
+  return text;
+}
+
+}  // namespace
+
+CLI::Validator count_in_range(long lo, long hi) {
+  const std::string range = "give a whole number from " + thousands(lo) + " to " + thousands(hi);
+  return CLI::Validator(
+      [lo, hi, range](std::string& value) -> std::string {
+        double number = 0;
+        std::size_t used = 0;
+        try {
+          number = std::stod(value, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != value.size()) return value + " is not a number: " + range;
+        if (!std::isfinite(number) || number < static_cast<double>(lo) || number > static_cast<double>(hi))
+          return value + " is out of range: " + range;
+        if (number != std::floor(number)) return value + " is not a whole number: " + range;
+        value = std::to_string(static_cast<long>(number));
+        return {};
+      },
+      "");
+}
+
+CLI::Validator output_file(std::vector<std::string> extensions) {
+  return CLI::Validator(
+      [extensions](std::string& value) -> std::string {
+        const fs::path path(value);
+        std::error_code ec;
+        if (fs::is_directory(path, ec))
+          return "'" + value + "' is a folder: give a file name in it, e.g. '" + (path / "out").string() +
+                 extensions.front() + "'";
+        const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+        if (!fs::is_directory(dir, ec))
+          return "cannot write '" + value + "': folder '" + dir.string() +
+                 "' does not exist; create it first";
+        const std::string name = lower(path.filename().string());
+        for (const std::string& ext : extensions)
+          if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0)
+            return {};
+        return "'" + value + "': this command writes " + listed(extensions) +
+               "; give a file name ending in " +
+               (extensions.size() == 1 ? extensions.front() : "one of them");
+      },
+      "");
+}
+
+CLI::Validator output_surface_file() {
+  return output_file({".stl", ".obj", ".ply", ".off", ".vtp"});
+}
+
+CLI::Validator output_folder() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        std::error_code ec;
+        if (fs::exists(value, ec) && !fs::is_directory(value, ec))
+          return "'" + value +
+                 "' is a file, not a folder: give a folder for the outputs (it is created if missing)";
+        return {};
+      },
+      "");
+}
+
+}  // namespace hexbite

@@ -1,0 +1,28 @@
+// CLI11 checks run while the command line is parsed, so a bad value is an input error (exit 2) before any
+// work: counts such as --target-hexes, and output files and folders.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace hexbite {
+
+// Counts: accepts a whole number written plainly or in scientific notation ("30000", "3e4") and rejects
+// fractions, non-numbers and counts outside [lo, hi] with a message that gives the range (CLI11's own
+// integer conversion rejects "3e4" and says only "Could not convert", without the range). A transforming
+// validator (add it with Option::transform): it rewrites an accepted value to its plain decimal form.
+CLI::Validator count_in_range(long lo, long hi);
+
+// An output file: its folder exists, it is not itself a folder, and it ends (in any case) in one of
+// `extensions` (".vtu", or ".nii.gz"), the formats the command writes. Checked before the work, so a typo
+// in -o does not cost a whole meshing run, and a .txt name never gets a VTU written into it.
+CLI::Validator output_file(std::vector<std::string> extensions);
+
+// An output surface: output_file with the formats write_surface knows (.stl, .obj, .ply, .off, .vtp).
+CLI::Validator output_surface_file();
+
+// An output folder: a folder or a path that does not exist yet (it is created), never an existing file.
+CLI::Validator output_folder();
+
+}  // namespace hexbite
