@@ -18,12 +18,14 @@
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/boundary_fit.h"
+#include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
 #include "mesher/units.h"
+#include "mesher/vec3.h"
 #include "postprocess/quality_json.h"
 
 namespace hexbite {
@@ -152,6 +154,39 @@ nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, boo
   return j;
 }
 
+// The mesh must be one made from the surface: its boundary nodes lie on it (up to the volume fit's offset,
+// a fraction of an edge). A mesh of another solid, or a surface in other units than --units says, would
+// otherwise be "refined" onto it, every new boundary node dragged tens of millimetres.
+void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surface,
+                             const RefineCliOptions& o) {
+  const HexBoundary boundary = extract_boundary(coarse);
+  double edges = 0;
+  long count = 0;
+  for (const auto& q : boundary.surface.quads)
+    for (int i = 0; i < 4; ++i, ++count)
+      edges +=
+          vec3::norm(vec3::sub(boundary.surface.vertices[q[(i + 1) % 4]], boundary.surface.vertices[q[i]]));
+  if (count == 0) return;
+  const double limit = 0.5 * edges / static_cast<double>(count);
+  long far = 0;
+  double farthest = 0;
+  int worst = -1;
+  for (int v : boundary.boundary_vertices) {
+    const double d = surface.closest(coarse.vertices[v]).distance;
+    if (d > limit) ++far;
+    if (d > farthest) farthest = d, worst = v;
+  }
+  if (far * 10 <= static_cast<long>(boundary.boundary_vertices.size())) return;
+  std::ostringstream text;
+  text.precision(3);
+  text << "'" << o.mesh << "' does not lie on '" << o.surface << "': " << far << " of "
+       << boundary.boundary_vertices.size() << " boundary nodes are farther than half a mean boundary edge ("
+       << limit << " mm) from it, up to " << farthest << " mm (node " << worst << " at ("
+       << coarse.vertices[worst][0] << ", " << coarse.vertices[worst][1] << ", " << coarse.vertices[worst][2]
+       << ") mm); give the surface the mesh was made from, in its units (--units, now " << o.units << ")";
+  throw InputError(text.str());
+}
+
 void run_refine(const RefineCliOptions& o) {
   if (o.fit_volume && o.surface.empty())
     throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
@@ -163,8 +198,10 @@ void run_refine(const RefineCliOptions& o) {
                      std::to_string(refined) + " hexes, more than " + std::to_string(kMaxRefinedHexes) +
                      "; use fewer levels");
   std::unique_ptr<SurfaceProjector> projector;
-  if (!o.surface.empty())
+  if (!o.surface.empty()) {
     projector = std::make_unique<SurfaceProjector>(load_closed_surface(o.surface, unit_to_mm(o.units)));
+    require_mesh_on_surface(coarse, *projector, o);
+  }
 
   RefineOptions options;
   options.levels = o.levels;

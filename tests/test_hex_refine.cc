@@ -238,6 +238,27 @@ TEST_F(BallRefine, CommandWritesTheRefinedMesh) {
   EXPECT_EQ(read_vtu(dir + "/plain.vtu").hexes.size(), 64 * coarse.hexes.size());
 }
 
+// A surface that is not the one the mesh was made from (another size, or the right one read in other units)
+// is an input error naming the farthest boundary node, before any refinement; nothing is written. Before,
+// the new boundary nodes were dragged onto it (exit 0 with a warning).
+TEST_F(BallRefine, CommandRefusesASurfaceTheMeshDoesNotLieOn) {
+  const std::string dir = temp_dir();
+  write_vtu(dir + "/coarse.vtu", coarse);
+  write_surface(dir + "/big.stl", sphere_surface(2.0 * radius, 16));
+  write_surface(dir + "/ball.stl", surface);
+  for (const std::vector<std::string>& extra :
+       {std::vector<std::string>{"--surface", dir + "/big.stl"},
+        std::vector<std::string>{"--surface", dir + "/ball.stl", "--units", "cm"}}) {
+    std::vector<std::string> args = {"refine", dir + "/coarse.vtu", "-o", dir + "/fine.vtu"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("'" + dir + "/coarse.vtu' does not lie on"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("give the surface the mesh was made from"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/fine.vtu"));
+  }
+}
+
 TEST(HexRefineCommand, BadInput) {
   const std::string dir = temp_dir();
   // An unreadable mesh.
