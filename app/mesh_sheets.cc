@@ -31,6 +31,7 @@ std::string report_text(const MeshSheetsOptions& o, const SheetMeshReport& r) {
       << " eliminations (" << r.eliminations_single << " single, " << r.eliminations_k_step << " k-step; "
       << r.external_sheets << " external, " << r.internal_sheets << " internal sheets), " << r.decompositions
       << " decompositions, " << r.hexes << " hexes, " << r.interior_vertices << " interior nodes\n";
+  out << look_ahead_text(r);
   if (r.pillow_hexes > 0)
     out << "pillow layer under the boundary: " << r.pillow_hexes << " hexes added, as "
         << r.inverted_without_pillow << " hexes stayed inverted without it\n";
@@ -94,9 +95,17 @@ void add_sheet_report_json(const SheetMeshReport& r, nlohmann::json& j) {
   j["external_sheets"] = r.external_sheets;
   j["internal_sheets"] = r.internal_sheets;
   j["decompositions"] = r.decompositions;
+  j["look_ahead_fallbacks"] = r.look_ahead_fallbacks;
   j["hexes"] = r.hexes;
   j["interior_nodes"] = r.interior_vertices;
   j["quality"] = quality_to_json(r.quality);
+}
+
+std::string look_ahead_text(const SheetMeshReport& r) {
+  if (r.look_ahead_fallbacks == 0) return {};
+  return std::string("the ") + elimination_order_name(r.order) +
+         " order ran into a dead end; the look-ahead order completed instead (" +
+         std::to_string(r.look_ahead_fallbacks) + (r.look_ahead_fallbacks > 1 ? " times" : " time") + ")\n";
 }
 
 std::string sheet_quality_text(const QualitySummary& q) {

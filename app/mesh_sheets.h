@@ -25,8 +25,10 @@ void run_mesh_sheets(const MeshSheetsOptions& options);
 // Shared by both sheets commands (this one and app/mesh_sheets_surface.h). The report's counts and quality
 // as JSON keys: quads, chords, eliminations {single, k_step}, sheets {external, internal},
 // eliminations_single, eliminations_k_step, chords_eliminated, external_sheets, internal_sheets,
-// decompositions, hexes, interior_nodes, quality.
+// decompositions, look_ahead_fallbacks, hexes, interior_nodes, quality.
 void add_sheet_report_json(const SheetMeshReport& report, nlohmann::json& j);
+// A line saying that the order ran into a dead end and the look-ahead order completed, or nothing.
+std::string look_ahead_text(const SheetMeshReport& report);
 // The interior node degree lines (edges, hexes) and the quality line, each ending in a newline.
 std::string sheet_quality_text(const QualitySummary& quality);
 

@@ -284,7 +284,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
         elimination_order_name(order), report.eliminations, report.eliminations_single,
         report.eliminations_k_step, report.external_sheets, report.internal_sheets, report.hexes,
         sheet_report.pillow_hexes, report.interior_vertices);
-    out << line;
+    out << line << look_ahead_text(report);
     out << sheet_quality_text(q);
     std::snprintf(
         line, sizeof line,

@@ -641,11 +641,33 @@ constexpr double kPillowInset = 0.4;
 // Splits whose parts mesh with less nesting come first: the search runs with the parts' nesting limited to
 // depth + 1, then depth + 2, ... max_depth. Adds the counts of eliminations, sheets and decompositions to
 // `counts`. The result's vertices 0..n-1 are the surface's.
+// The chosen order, and where it runs into a dead end the look-ahead order (which avoids dead ends) before a
+// decomposition: on the edentulous built-in mandible the geometric order got stuck after 89 eliminations and
+// the decomposition gave 4,157 hexes of SJ 0.247 / 0.805, where the look-ahead order completes with 2,477
+// hexes of 0.543 / 0.881 (docs/sheets.md). Throws the chosen order's RunError when both are stuck.
+EliminationScheme eliminate_or_look_ahead(const QuadSurface& surface, const EliminationOptions& options,
+                                          SheetMeshReport& counts) {
+  try {
+    return eliminate_chords(surface, options);
+  } catch (const RunError&) {
+    if (options.order == EliminationOrder::kLookAhead || !options.look_ahead_after_dead_end) throw;
+    EliminationOptions look_ahead = options;
+    look_ahead.order = EliminationOrder::kLookAhead;
+    try {
+      EliminationScheme scheme = eliminate_chords(surface, look_ahead);
+      ++counts.look_ahead_fallbacks;
+      return scheme;
+    } catch (const RunError&) {
+    }
+    throw;
+  }
+}
+
 HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& options, int depth, int max_depth,
                       SheetMeshReport& counts) {
   EliminationScheme scheme;
   try {
-    scheme = eliminate_chords(surface, options.elimination);
+    scheme = eliminate_or_look_ahead(surface, options.elimination, counts);
   } catch (const RunError& stuck) {
     if (depth >= max_depth) throw;
     const int n = static_cast<int>(surface.vertices.size());
@@ -691,6 +713,7 @@ HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& option
         counts.external_sheets += part_counts.external_sheets;
         counts.internal_sheets += part_counts.internal_sheets;
         counts.decompositions += part_counts.decompositions + 1;
+        counts.look_ahead_fallbacks += part_counts.look_ahead_fallbacks;
         return true;
       });
     if (search.accepted) return glued;

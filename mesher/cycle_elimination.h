@@ -111,6 +111,10 @@ struct EliminationOptions {
   // The best measured (docs/sheets.md): equal to the others on blocks, polycubes, box chains and spheres,
   // as good on the jaw's quad surface, valid where they leave inverted hexes (the O-grid disk).
   EliminationOrder order = EliminationOrder::kGeometric;
+  // Where `order` runs into a dead end (no feasible chord left), mesh_by_cycle_elimination eliminates again
+  // in the look-ahead order before it decomposes along a primal cycle
+  // (SheetMeshReport::look_ahead_fallbacks).
+  bool look_ahead_after_dead_end = true;
   // Chords to eliminate before the order chooses, each named by one of its rungs (an edge {a, b} of the
   // input surface), in this order: at its turn a rung still on a simple chord whose single elimination is
   // feasible (and, in the look-ahead orders, no dead end) is eliminated on its smaller side; rungs that a
@@ -150,12 +154,13 @@ struct SheetMeshOptions {
 
 struct SheetMeshReport {
   int quads = 0;
-  int chords = 0;               // chords of the input surface
-  int eliminations = 0;         // steps
-  int eliminations_single = 0;  // steps of one chord
-  int eliminations_k_step = 0;  // steps of k >= 2 chords
-  int chords_eliminated = 0;    // chords - 3 for a complete scheme without decomposition
-  int decompositions = 0;       // splits along a primal cycle (nested ones included)
+  int chords = 0;                // chords of the input surface
+  int eliminations = 0;          // steps
+  int eliminations_single = 0;   // steps of one chord
+  int eliminations_k_step = 0;   // steps of k >= 2 chords
+  int chords_eliminated = 0;     // chords - 3 for a complete scheme without decomposition
+  int decompositions = 0;        // splits along a primal cycle (nested ones included)
+  int look_ahead_fallbacks = 0;  // surfaces (or parts) where the order was stuck and the look-ahead was not
   int external_sheets = 0;
   int internal_sheets = 0;
   int hexes = 0;
@@ -171,9 +176,9 @@ struct SheetMeshReport {
   int inverted_without_pillow = 0;
 };
 
-// Steps 1 to 3, with decomposition where the elimination is stuck. The counts of eliminations and sheets
-// add up over the parts of a decomposition. With options.optimize, InputError when a quad has three
-// collinear corners (no valid hex mesh has that boundary).
+// Steps 1 to 3, with the look-ahead order and then decomposition where the elimination is stuck. The counts
+// of eliminations and sheets add up over the parts of a decomposition. With options.optimize, InputError when
+// a quad has three collinear corners (no valid hex mesh has that boundary).
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
                                   SheetMeshReport* report = nullptr);
 

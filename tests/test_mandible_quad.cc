@@ -363,6 +363,22 @@ TEST(MandibleQuadsCli, MeshSheetsFromTheGeneratedMandibleIsValid) {
   EXPECT_LT(j["fidelity"]["hausdorff_mm"].get<double>(), 2.9);
 }
 
+// The edentulous variant: the geometric order runs into a dead end after 88 eliminations; before the
+// look-ahead fallback a decomposition along a primal cycle gave 4,157 hexes of SJ 0.247 / 0.805. Now the
+// look-ahead order completes: measured 2,477 hexes, SJ 0.543 / 0.881, no decomposition.
+TEST(MandibleQuadsCli, MeshSheetsFromTheEdentulousMandibleFallsBackToTheLookAhead) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(test::run_hexbite({"generate", "mandible", "--variant", "edentulous", "-o", dir + "/m.stl",
+                               "--landmarks", dir + "/m.yaml"})
+                .exit_code,
+            0);
+  const auto j = expect_valid_sheet_mesh(dir + "/m.stl", dir + "/m.yaml", dir);
+  EXPECT_EQ(j["look_ahead_fallbacks"], 1);
+  EXPECT_EQ(j["decompositions"], 0);
+  EXPECT_GT(j["quality"]["scaled_jacobian"]["min"].get<double>(), 0.5);
+  EXPECT_GT(j["quality"]["scaled_jacobian"]["mean"].get<double>(), 0.87);
+}
+
 TEST(MandibleQuadsCli, MeshSheetsFromTheRealJawIsValid) {
   const std::string dir = test::temp_dir();
   const auto j = expect_valid_sheet_mesh(test::shared_data("jaw/jaw_smooth.stl"),
