@@ -39,6 +39,20 @@ std::string format_point(const Vec3& p) {
   return s.str();
 }
 
+// A body (an outer shell with its voids) that no grid component represents: no cell centre lies inside it
+// at this cell size.
+struct MissedBody {
+  int body = -1;
+  Vec3 lo{}, hi{};  // the bounding box of its outer shell
+  int cells = 0;    // cells of dropped components nearest to it
+};
+
+// Bodies that one core component holds: the gap between them is narrower than a cell, the mesh joins them.
+struct JoinedBodies {
+  std::vector<int> bodies;
+  Vec3 contact{};  // centroid of the cells inside one body with a face neighbour inside another
+};
+
 // A regular grid of n[0] x n[1] x n[2] cubic cells of size h; cell (i, j, k) spans
 // origin + h * [i, i+1] x [j, j+1] x [k, k+1]. The outermost layer of cells lies outside the surface's
 // bounding box, so the unselected cells always surround the selected ones.
@@ -60,15 +74,114 @@ struct Grid {
   long vertex(int i, int j, int k) const { return (long(k) * (n[1] + 1) + j) * (n[0] + 1) + i; }
 };
 
+// The surface's closed shells (triangles connected through shared vertices) grouped into bodies: each
+// outer shell (positive enclosed volume) is a body, each inner shell (negative volume: a void) belongs to
+// the body of the smallest outer shell around it. A fractured mandible has two bodies; a hollow solid one
+// body with a void.
+struct Shells {
+  std::vector<int> shell_of_triangle;
+  std::vector<int> body_of_shell;
+  std::vector<char> inner;             // per shell: a void
+  std::vector<Vec3> body_lo, body_hi;  // bounding box of each body's outer shell
+  std::vector<long> body_triangles;    // triangles of each body's outer shell
+  std::vector<long> shell_triangles;   // triangles of each shell
+  int bodies = 0;
+  bool any_inner = false;
+  // Cells are labelled (body, void) only for several bodies or voids; a single shell meshes as before.
+  bool labelled() const { return bodies > 1 || any_inner; }
+};
+
+// The winding number of a closed shell's triangles around p: 1 inside an outward oriented shell, 0 outside
+// (the solid angles of its triangles over 4 pi).
+double winding_number(const TriSurface& surface, const std::vector<int>& triangles, const Vec3& p) {
+  double sum = 0;
+  for (int t : triangles) {
+    const Vec3 a = sub(surface.vertices[surface.triangles[t][0]], p);
+    const Vec3 b = sub(surface.vertices[surface.triangles[t][1]], p);
+    const Vec3 c = sub(surface.vertices[surface.triangles[t][2]], p);
+    const double la = norm(a), lb = norm(b), lc = norm(c);
+    sum += 2.0 *
+           std::atan2(dot(a, cross(b, c)), la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la);
+  }
+  return sum / (4.0 * M_PI);
+}
+
+Shells find_shells(const TriSurface& surface) {
+  Shells sh;
+  const std::size_t nt = surface.triangles.size();
+  std::vector<int> parent(surface.vertices.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const auto& tri : surface.triangles) parent[find(tri[1])] = parent[find(tri[2])] = find(tri[0]);
+  std::vector<int> shell_of_root(surface.vertices.size(), -1);
+  std::vector<std::vector<int>> members;
+  sh.shell_of_triangle.resize(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    int& shell = shell_of_root[find(surface.triangles[t][0])];
+    if (shell < 0) shell = int(members.size()), members.emplace_back();
+    members[shell].push_back(int(t));
+    sh.shell_of_triangle[t] = shell;
+  }
+  const int n = int(members.size());
+  // Six times each shell's enclosed volume (divergence theorem, as enclosed_volume).
+  std::vector<double> volume(n, 0.0);
+  for (int q = 0; q < n; ++q) {
+    for (int t : members[q]) {
+      const Vec3& a = surface.vertices[surface.triangles[t][0]];
+      volume[q] +=
+          dot(a, cross(surface.vertices[surface.triangles[t][1]], surface.vertices[surface.triangles[t][2]]));
+    }
+    sh.shell_triangles.push_back(long(members[q].size()));
+  }
+  sh.inner.assign(n, 0);
+  sh.body_of_shell.assign(n, -1);
+  std::vector<int> outer;
+  for (int q = 0; q < n; ++q) {
+    if (volume[q] < 0) {
+      sh.inner[q] = 1, sh.any_inner = true;
+      continue;
+    }
+    sh.body_of_shell[q] = sh.bodies++;
+    outer.push_back(q);
+    Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+    for (int t : members[q])
+      for (int v : surface.triangles[t])
+        for (int a = 0; a < 3; ++a)
+          lo[a] = std::min(lo[a], surface.vertices[v][a]), hi[a] = std::max(hi[a], surface.vertices[v][a]);
+    sh.body_lo.push_back(lo);
+    sh.body_hi.push_back(hi);
+    sh.body_triangles.push_back(long(members[q].size()));
+  }
+  for (int q = 0; q < n; ++q) {
+    if (!sh.inner[q]) continue;
+    const Vec3& p = surface.vertices[surface.triangles[members[q][0]][0]];
+    int around = -1;
+    for (int o : outer)
+      if (winding_number(surface, members[o], p) > 0.5 && (around < 0 || volume[o] < volume[around]))
+        around = o;
+    sh.body_of_shell[q] = around >= 0 ? sh.body_of_shell[around] : 0;
+  }
+  return sh;
+}
+
 // The selected cells for one cell size, with the data needed to repair and score them.
 struct Selection {
   Grid grid;
   std::vector<char> inside;   // cell centre inside the surface
   std::vector<double> score;  // signed distance of the cell centre (positive inside); NaN = not computed
   std::vector<char> selected;
+  // With several bodies or with voids (Shells::labelled): the body of each cell whose centre lies inside
+  // the solid (-1 for the others), and whether a cell's centre lies in a void (inside an inner shell).
+  std::vector<int> body;
+  std::vector<char> in_void;
   int added_for_manifold = 0;
-  int dropped = 0;
+  int dropped = 0;  // cells of dropped fragments of a body that has its main component (narrow necks)
   Vec3 dropped_centroid{};
+  std::vector<MissedBody> missed;    // bodies without a main component
+  std::vector<JoinedBodies> joined;  // kept components that hold several bodies
   long core_cells = 0;
   long boundary_quads = 0;
 };
@@ -106,27 +219,54 @@ int face_neighbours(const Grid& g, long c, long out[6]) {
 
 // Inside flags of all cell centres: crossing parity along each grid column, with a per-cell inside test
 // where the column grazes an edge or a vertex of the surface.
-void classify(Selection& s, const SurfaceProjector& surface) {
+// With several bodies or voids (Shells::labelled) also the body of each inside cell (the body of the
+// last shell crossed below it: entering its outer shell or leaving one of its voids) and the void cells
+// (outside the solid, inside an odd number of crossings of an inner shell below it); where the column
+// grazes, the shell of the closest surface point decides.
+void classify(Selection& s, const SurfaceProjector& surface, const Shells& shells) {
   const Grid& g = s.grid;
   s.inside.assign(g.cells(), 0);
+  const bool labelled = shells.labelled();
+  if (labelled) s.body.assign(g.cells(), -1), s.in_void.assign(g.cells(), 0);
+  std::vector<int> parity(shells.inner.size(), 0);
   std::vector<double> t;
+  std::vector<int> crossed;
   for (int j = 0; j < g.n[1]; ++j)
     for (int i = 0; i < g.n[0]; ++i) {
       const Vec3 c0 = g.centre(i, j, 0);
       const Vec3 a{c0[0], c0[1], g.origin[2] - g.h};
       const Vec3 b{c0[0], c0[1], g.origin[2] + (g.n[2] + 1) * g.h};
-      const bool ok = surface.segment_crossings(a, b, &t);
+      const bool ok = surface.segment_crossings(a, b, &t, labelled ? &crossed : nullptr);
+      std::size_t below = 0;  // labelled: crossings below the current cell centre, counted in `parity`
+      int open_voids = 0;     // inner shells crossed an odd number of times below the centre
       for (int k = 0; k < g.n[2]; ++k) {
         const Vec3 c = g.centre(i, j, k);
+        const long cell = g.cell(i, j, k);
         bool in;
         if (ok) {
           const double tc = (c[2] - a[2]) / (b[2] - a[2]);
-          in = (std::lower_bound(t.begin(), t.end(), tc) - t.begin()) % 2 == 1;
+          const std::size_t m = std::lower_bound(t.begin(), t.end(), tc) - t.begin();
+          in = m % 2 == 1;
+          if (labelled) {
+            for (; below < m; ++below) {
+              const int shell = shells.shell_of_triangle[crossed[below]];
+              if (shells.inner[shell]) open_voids += (parity[shell] ^= 1) ? 1 : -1;
+            }
+            if (in && m > 0) s.body[cell] = shells.body_of_shell[shells.shell_of_triangle[crossed[m - 1]]];
+            if (!in) s.in_void[cell] = open_voids > 0;
+          }
         } else {
           in = surface.inside(c);
+          if (labelled) {
+            const int shell = shells.shell_of_triangle[surface.closest(c).triangle];
+            if (in) s.body[cell] = shells.body_of_shell[shell];
+            if (!in) s.in_void[cell] = shells.inner[shell];
+          }
         }
-        s.inside[g.cell(i, j, k)] = in;
+        s.inside[cell] = in;
       }
+      if (labelled)
+        for (std::size_t q = 0; q < below; ++q) parity[shells.shell_of_triangle[crossed[q]]] = 0;
     }
 }
 
@@ -237,7 +377,109 @@ void keep_largest_component(Selection& s) {
   if (s.dropped > 0) s.dropped_centroid = scale(sum, 1.0 / s.dropped);
 }
 
-// Selects every unselected cell that the outside cannot reach through faces (an enclosed cavity).
+// Several bodies: keeps each body's main component, the face-connected component with the most cells
+// whose centre lies inside that body (the first one on a tie). Dropped components with cells inside a
+// body, or without inside cells and nearest to a represented body, are its fragments (narrow necks:
+// dropped, dropped_centroid); a body without inside cells is missed (missed, with the cells of the
+// components nearest to it); a kept component with cells inside several bodies joins them (joined).
+void keep_main_components(Selection& s, const SurfaceProjector& surface, const Shells& shells) {
+  const Grid& g = s.grid;
+  const long nc = g.cells();
+  std::vector<int> label(nc, -1);
+  std::vector<long> first;                 // a cell of each component
+  std::vector<std::vector<long>> in_body;  // per component: cells inside each body
+  for (long c = 0; c < nc; ++c) {
+    if (!s.selected[c] || label[c] >= 0) continue;
+    const int id = int(first.size());
+    first.push_back(c);
+    in_body.emplace_back(shells.bodies, 0);
+    std::vector<long> stack{c};
+    label[c] = id;
+    while (!stack.empty()) {
+      const long x = stack.back();
+      stack.pop_back();
+      if (s.body[x] >= 0) ++in_body[id][s.body[x]];
+      long nb[6];
+      const int m = face_neighbours(g, x, nb);
+      for (int q = 0; q < m; ++q)
+        if (s.selected[nb[q]] && label[nb[q]] < 0) label[nb[q]] = id, stack.push_back(nb[q]);
+    }
+  }
+  const int components = int(first.size());
+  std::vector<char> keep(components, 0);
+  std::vector<int> main_of(shells.bodies, -1);
+  for (int b = 0; b < shells.bodies; ++b) {
+    for (int id = 0; id < components; ++id)
+      if (in_body[id][b] > 0 && (main_of[b] < 0 || in_body[id][b] > in_body[main_of[b]][b])) main_of[b] = id;
+    if (main_of[b] >= 0) keep[main_of[b]] = 1;
+  }
+  // The body each dropped component belongs to: a body it has cells inside, else the body of the surface
+  // point closest to one of its cells.
+  std::vector<int> owner(components, -1);
+  for (int id = 0; id < components; ++id) {
+    if (keep[id]) continue;
+    for (int b = 0; b < shells.bodies && owner[id] < 0; ++b)
+      if (in_body[id][b] > 0) owner[id] = b;
+    if (owner[id] < 0) {
+      int i, j, k;
+      g.ijk(first[id], i, j, k);
+      owner[id] = shells.body_of_shell[shells.shell_of_triangle[surface.closest(g.centre(i, j, k)).triangle]];
+    }
+  }
+  std::vector<int> missed_index(shells.bodies, -1);
+  for (int b = 0; b < shells.bodies; ++b)
+    if (main_of[b] < 0) {
+      missed_index[b] = int(s.missed.size());
+      s.missed.push_back({b, shells.body_lo[b], shells.body_hi[b], 0});
+    }
+  Vec3 sum{0, 0, 0};
+  for (long c = 0; c < nc; ++c) {
+    if (!s.selected[c] || keep[label[c]]) continue;
+    s.selected[c] = 0;
+    const int b = owner[label[c]];
+    if (missed_index[b] >= 0) {
+      ++s.missed[missed_index[b]].cells;
+      continue;
+    }
+    ++s.dropped;
+    int i, j, k;
+    g.ijk(c, i, j, k);
+    sum = add(sum, g.centre(i, j, k));
+  }
+  if (s.dropped > 0) s.dropped_centroid = scale(sum, 1.0 / s.dropped);
+  for (int id = 0; id < components; ++id) {
+    if (!keep[id]) continue;
+    JoinedBodies joined;
+    for (int b = 0; b < shells.bodies; ++b)
+      if (in_body[id][b] > 0) joined.bodies.push_back(b);
+    if (joined.bodies.size() < 2) continue;
+    Vec3 contact{0, 0, 0};
+    long count = 0;
+    for (long c = 0; c < nc; ++c) {
+      if (label[c] != id || s.body[c] < 0) continue;
+      long nb[6];
+      const int m = face_neighbours(g, c, nb);
+      bool touches = false;
+      for (int q = 0; q < m; ++q) touches = touches || (s.body[nb[q]] >= 0 && s.body[nb[q]] != s.body[c]);
+      if (!touches) continue;
+      int i, j, k;
+      g.ijk(c, i, j, k);
+      contact = add(contact, g.centre(i, j, k));
+      ++count;
+    }
+    if (count == 0) {  // joined through cells outside both: between the first two bodies' boxes
+      for (int b : {joined.bodies[0], joined.bodies[1]})
+        contact = add(contact, scale(add(shells.body_lo[b], shells.body_hi[b]), 0.25));
+      count = 1;
+    }
+    joined.contact = scale(contact, 1.0 / count);
+    s.joined.push_back(joined);
+  }
+}
+
+// Selects every unselected cell that the outside cannot reach through faces (an enclosed cavity). With
+// voids (Selection::in_void), an enclosed cavity that holds a void cell is a void of the solid and stays
+// open; the others (cells inside the solid that the margins left out) are filled.
 int fill_cavities(Selection& s) {
   const Grid& g = s.grid;
   const long nc = g.cells();
@@ -253,8 +495,30 @@ int fill_cavities(Selection& s) {
       if (!s.selected[nb[q]] && !reached[nb[q]]) reached[nb[q]] = 1, stack.push_back(nb[q]);
   }
   int filled = 0;
-  for (long c = 0; c < nc; ++c)
-    if (!s.selected[c] && !reached[c]) s.selected[c] = 1, ++filled;
+  if (s.in_void.empty()) {
+    for (long c = 0; c < nc; ++c)
+      if (!s.selected[c] && !reached[c]) s.selected[c] = 1, ++filled;
+    return filled;
+  }
+  for (long c = 0; c < nc; ++c) {
+    if (s.selected[c] || reached[c]) continue;
+    // One enclosed cavity, marked reached as it is collected.
+    std::vector<long> cavity{c};
+    bool is_void = s.in_void[c];
+    reached[c] = 1;
+    for (std::size_t q = 0; q < cavity.size(); ++q) {
+      long nb[6];
+      const int m = face_neighbours(g, cavity[q], nb);
+      for (int r = 0; r < m; ++r)
+        if (!s.selected[nb[r]] && !reached[nb[r]]) {
+          reached[nb[r]] = 1;
+          cavity.push_back(nb[r]);
+          is_void = is_void || s.in_void[nb[r]];
+        }
+    }
+    if (is_void) continue;
+    for (long x : cavity) s.selected[x] = 1, ++filled;
+  }
   return filled;
 }
 
@@ -482,8 +746,8 @@ struct CoreSelection {
 };
 
 // The selection for cell size h, the grid shifted by `shift` cells along every axis.
-Selection build_selection(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, double h,
-                          double shift, const CoreSelection& how) {
+Selection build_selection(const SurfaceProjector& surface, const Shells& shells, const Vec3& lo,
+                          const Vec3& hi, double h, double shift, const CoreSelection& how) {
   Selection s;
   s.grid.h = h;
   for (int a = 0; a < 3; ++a) {
@@ -492,12 +756,15 @@ Selection build_selection(const SurfaceProjector& surface, const Vec3& lo, const
     // Centre the grid on the bounding box, so that the result does not depend on which corner is lower.
     s.grid.origin[a] = 0.5 * (lo[a] + hi[a]) - (0.5 * s.grid.n[a] - shift) * h;
   }
-  classify(s, surface);
+  classify(s, surface, shells);
   select_core(s, surface, how.margin, how.thick_margin, how.thin_cells);
   // Manifold repair first: a part that touches the rest only along an edge or at a vertex (a thin process
   // at this cell size) is then joined by a cell instead of being dropped as a separate component.
   make_manifold(s, surface);
-  keep_largest_component(s);
+  if (shells.bodies > 1)
+    keep_main_components(s, surface, shells);
+  else
+    keep_largest_component(s);
   fill_cavities(s);
   make_manifold(s, surface);
   if (how.regularize) regularize_core(s, surface, how.inside, how.outside);
@@ -587,8 +854,10 @@ int add_pillow_layer(HexMesh& mesh, const SurfaceProjector& surface, double h) {
   return int(q.quads.size());
 }
 
-// Surface regions farther than `limit` from the mesh boundary, grouped by shared triangle vertices.
-std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
+// Surface regions farther than `limit` from the mesh boundary, grouped by shared triangle vertices. A
+// region that is a whole shell of a surface with several shells, far everywhere (every vertex and centroid),
+// is named as a separate shell (a body) or a void that the mesh does not reach.
+std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const Shells& shells,
                                                const std::vector<double>& vertex_dist,
                                                const std::vector<double>& centroid_dist, double limit) {
   const std::size_t nt = surface.triangles.size();
@@ -611,7 +880,9 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
   }
   std::vector<int> region(surface.vertices.size(), -1);
   std::vector<UnresolvedPart> parts;
-  std::vector<Vec3> sums;
+  std::vector<Vec3> sums, lows, highs;
+  std::vector<int> shell_of_part;
+  std::vector<long> wholly_far;  // per part: triangles whose vertices and centroid are all far
   for (std::size_t t = 0; t < nt; ++t) {
     if (!far_triangle[t]) continue;
     const auto& tri = surface.triangles[t];
@@ -620,12 +891,24 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
       region[root] = int(parts.size());
       parts.push_back({});
       sums.push_back({0, 0, 0});
+      lows.push_back({kInf, kInf, kInf});
+      highs.push_back({-kInf, -kInf, -kInf});
+      shell_of_part.push_back(shells.shell_of_triangle[t]);
+      wholly_far.push_back(0);
     }
     UnresolvedPart& p = parts[region[root]];
     const Vec3& a = surface.vertices[tri[0]];
     const Vec3& b = surface.vertices[tri[1]];
     const Vec3& c = surface.vertices[tri[2]];
     sums[region[root]] = add(sums[region[root]], scale(add(add(a, b), c), 1.0 / 3.0));
+    bool wholly = centroid_dist[t] > limit;
+    for (int v : tri) wholly = wholly && vertex_dist[v] > limit;
+    wholly_far[region[root]] += wholly;
+    for (int v : tri)
+      for (int e = 0; e < 3; ++e) {
+        lows[region[root]][e] = std::min(lows[region[root]][e], surface.vertices[v][e]);
+        highs[region[root]][e] = std::max(highs[region[root]][e], surface.vertices[v][e]);
+      }
     ++p.samples;
     p.extent = std::max(p.extent, centroid_dist[t]);
     for (int v : tri) p.extent = std::max(p.extent, vertex_dist[v]);
@@ -635,8 +918,24 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface,
     std::ostringstream extent;
     extent.precision(1);
     extent << std::fixed << parts[r].extent;
-    parts[r].what = "the surface near " + format_point(parts[r].location) + " lies up to " + extent.str() +
-                    " mm from the mesh (" + std::to_string(parts[r].samples) +
+    const int shell = shell_of_part[r];
+    if (shells.shell_triangles.size() > 1 && wholly_far[r] == shells.shell_triangles[shell]) {
+      std::ostringstream size;
+      size.precision(1);
+      size << std::fixed << highs[r][0] - lows[r][0] << " x " << highs[r][1] - lows[r][1] << " x "
+           << highs[r][2] - lows[r][2] << " mm";
+      parts[r].what =
+          (shells.inner[shell] ? "the whole void near " : "the whole separate shell near ") +
+          format_point(parts[r].location) + " (" + size.str() + ") lies up to " + extent.str() +
+          " mm from the mesh (" + std::to_string(parts[r].samples) + " triangles): " +
+          (shells.inner[shell] ? "a void smaller than a cell is filled at this cell size"
+                               : "a body smaller or thinner than a cell is not meshed at this size") +
+          "; ask for more hexes to resolve it";
+      continue;
+    }
+    parts[r].what = std::string(shells.inner[shell] ? "the void's surface near " : "the surface near ") +
+                    format_point(parts[r].location) + " lies up to " + extent.str() + " mm from the mesh (" +
+                    std::to_string(parts[r].samples) +
                     " triangles): a part too thin for this cell size; ask for more hexes to resolve it";
   }
   std::stable_sort(parts.begin(), parts.end(),
@@ -749,7 +1048,7 @@ MeshFidelity measure_fidelity(const HexMesh& mesh, const SurfaceProjector& surfa
   f.mesh_volume = hex_mesh_volume(mesh);
   f.surface_volume = enclosed_volume(s);
   f.volume_difference = f.surface_volume != 0 ? (f.mesh_volume - f.surface_volume) / f.surface_volume : 0.0;
-  f.unresolved = unresolved_regions(s, vertex_dist, centroid_dist, 0.5 * f.mean_edge_length);
+  f.unresolved = unresolved_regions(s, find_shells(s), vertex_dist, centroid_dist, 0.5 * f.mean_edge_length);
   return f;
 }
 
@@ -773,8 +1072,9 @@ enum class CoreRule {
 };
 
 // Steps 1 and 2 of one grid, shifted by `shift` cells: the cell size and the core (`mesh` holds the core).
-GridAttempt grid_core(const SurfaceProjector& projector, const Vec3& lo, const Vec3& hi, double volume,
-                      double mean_thickness, const GridMeshOptions& options, double shift, CoreRule rule) {
+GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, const Vec3& lo, const Vec3& hi,
+                      double volume, double mean_thickness, const GridMeshOptions& options, double shift,
+                      CoreRule rule) {
   const auto t_attempt = std::chrono::steady_clock::now();
   GridAttempt out;
   GridMeshReport& r = out.report;
@@ -800,7 +1100,7 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Vec3& lo, const V
       how.inside = options.regular_inside;
       how.outside = options.regular_outside;
     }
-    Selection s = build_selection(projector, lo, hi, h, shift, how);
+    Selection s = build_selection(projector, shells, lo, hi, h, shift, how);
     const double total = double(s.core_cells + s.boundary_quads);
     const double error = std::fabs(total - target) / target;
     if (s.core_cells > 0 && error < best_error) {
@@ -828,6 +1128,7 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Vec3& lo, const V
   r.grid = best.grid.n;
   r.cells_added_for_manifold = best.added_for_manifold;
   r.cells_in_dropped_components = best.dropped;
+  for (const MissedBody& m : best.missed) r.cells_in_dropped_components += m.cells;
   std::tie(r.core_boundary_vertices, r.irregular_core_boundary_vertices) = boundary_valences(best);
   out.mesh = core_mesh(best);
   r.core_hexes = int(out.mesh.hexes.size());
@@ -855,6 +1156,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
                      std::to_string(options.target_hexes));
   const auto t_start = std::chrono::steady_clock::now();
   const SurfaceProjector projector(surface);
+  const Shells shells = find_shells(surface);
   const double volume = enclosed_volume(surface);
   if (!(volume > 0))
     throw InputError("grid mesher: the surface encloses no volume (is it oriented outward?)");
@@ -920,8 +1222,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   auto run_job = [&](int a) {
     try {
       if (a > 0)
-        attempts[a] =
-            grid_core(projector, lo, hi, volume, mean_thickness, options, jobs[a].shift, jobs[a].rule);
+        attempts[a] = grid_core(projector, shells, lo, hi, volume, mean_thickness, options, jobs[a].shift,
+                                jobs[a].rule);
       pillow_and_optimize(attempts[a], projector, per_grid);
     } catch (...) {
       errors[a] = std::current_exception();
@@ -943,7 +1245,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     std::vector<std::thread> helpers;
     for (int t = 1; t < std::clamp(options.threads, 1, 4); ++t) helpers.emplace_back(work, true);
     try {
-      attempts[0] = grid_core(projector, lo, hi, volume, mean_thickness, options, shifts[0], jobs[0].rule);
+      attempts[0] =
+          grid_core(projector, shells, lo, hi, volume, mean_thickness, options, shifts[0], jobs[0].rule);
       decide_jobs(attempts[0].fine);
       run_job(0);
     } catch (...) {
@@ -1030,6 +1333,51 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     part.what =
         std::to_string(kept.dropped) + " grid cells around " + format_point(kept.dropped_centroid) +
         " were not face-connected to the main core and were dropped (a narrow neck at this cell size)";
+    report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
+  }
+  std::ostringstream cell;
+  cell.precision(2);
+  cell << std::fixed << kept.grid.h;
+  for (auto j = kept.joined.rbegin(); j != kept.joined.rend(); ++j) {
+    UnresolvedPart part;
+    part.location = j->contact;
+    std::string around;
+    for (int b : j->bodies)
+      around += (around.empty()          ? ""
+                 : b == j->bodies.back() ? " and "
+                                         : ", ") +
+                format_point(scale(add(shells.body_lo[b], shells.body_hi[b]), 0.5));
+    part.what = "the separate shells of the surface around " + around + " come closer than a cell (" +
+                cell.str() + " mm) near " + format_point(part.location) +
+                ": the mesh joins them across the gap; ask for more hexes to resolve it";
+    report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
+  }
+  for (auto m = kept.missed.rbegin(); m != kept.missed.rend(); ++m) {
+    UnresolvedPart part;
+    part.location = scale(add(m->lo, m->hi), 0.5);
+    part.samples = int(shells.body_triangles[m->body]);
+    std::ostringstream size;
+    size.precision(1);
+    size << std::fixed << m->hi[0] - m->lo[0] << " x " << m->hi[1] - m->lo[1] << " x " << m->hi[2] - m->lo[2]
+         << " mm";
+    // The fidelity check finds the same shell far from the mesh: its distance goes here, once.
+    auto& found = report.fidelity.unresolved;
+    for (auto f = found.begin(); f != found.end(); ++f) {
+      bool in_box = f->what.rfind("the whole separate shell near", 0) == 0;
+      for (int a = 0; a < 3; ++a)
+        in_box = in_box && f->location[a] >= m->lo[a] - 1e-9 && f->location[a] <= m->hi[a] + 1e-9;
+      if (!in_box) continue;
+      part.extent = f->extent;
+      found.erase(f);
+      break;
+    }
+    std::ostringstream extent;
+    extent.precision(1);
+    extent << std::fixed << part.extent;
+    part.what = "a separate shell of the surface around " + format_point(part.location) + " (" + size.str() +
+                ") holds no grid cell centre at this cell size (" + cell.str() +
+                " mm) and was not meshed (it lies up to " + extent.str() +
+                " mm from the mesh): a body smaller or thinner than a cell; ask for more hexes to resolve it";
     report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
   }
   report.seconds_fidelity = seconds_since(t0);

@@ -17,7 +17,11 @@
 //      different grids (step 5); inside by crossing parity along grid columns, distances from the AABB tree.
 //      Cells are added until no two cells share only an edge or a vertex and the core boundary is a
 //      2-manifold (this also joins parts that touch the rest only along an edge), the largest face-connected
-//      component is kept and enclosed cavities are filled;
+//      component is kept and enclosed cavities are filled. With several shells the surface is grouped into
+//      bodies (an outer shell with the inner shells, voids, nested in it): each body keeps its main component
+//      (the one with the most cells whose centre lies inside that body; a body without one is reported as a
+//      separate shell smaller than a cell), only other fragments are dropped as narrow necks, and an enclosed
+//      cavity that holds a cell inside a void stays open (its boundary is pillowed onto the inner shell);
 //   3. pillow layer: core boundary vertices outside or near the surface are pulled below it, then each gets
 //      a copy on the surface (along the vertex normal, or the closest point), and each core boundary quad one
 //      hex to it, so no hex has two boundary faces;
@@ -122,8 +126,9 @@ struct NearbyPoint {
   double distance = 0;  // from the part's location, mm
 };
 
-// A region of the surface that the mesh does not reach (a part too thin for the cell size, or a core
-// component that was dropped because it is not face-connected to the largest one).
+// A region of the surface that the mesh does not reach (a part too thin for the cell size, a core
+// component that was dropped because it is not face-connected to its body's main one, a separate shell
+// smaller than a cell, or separate shells closer than a cell that the mesh joins).
 struct UnresolvedPart {
   Vec3 location{};    // centroid of the region, mm
   double extent = 0;  // largest distance of the region's surface from the mesh boundary, mm

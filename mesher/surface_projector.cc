@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <utility>
 
 #include "common/error.h"
 
@@ -124,7 +125,8 @@ bool SurfaceProjector::first_hit(const Vec3& origin, const Vec3& direction, doub
   return true;
 }
 
-bool SurfaceProjector::segment_crossings(const Vec3& a, const Vec3& b, std::vector<double>* t) const {
+bool SurfaceProjector::segment_crossings(const Vec3& a, const Vec3& b, std::vector<double>* t,
+                                         std::vector<int>* triangles) const {
   const Kernel::Segment_3 seg(Point(a[0], a[1], a[2]), Point(b[0], b[1], b[2]));
   using Hit = Tree::Intersection_and_primitive_id<Kernel::Segment_3>::Type;
   std::vector<Hit> hits;
@@ -132,10 +134,20 @@ bool SurfaceProjector::segment_crossings(const Vec3& a, const Vec3& b, std::vect
   const Vec3 ab{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   const double len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
   t->clear();
+  std::vector<std::pair<double, int>> crossed;
   for (const Hit& h : hits) {
     const Point* p = boost::get<Point>(&h.first);
     if (p == nullptr) return false;
-    t->push_back(((p->x() - a[0]) * ab[0] + (p->y() - a[1]) * ab[1] + (p->z() - a[2]) * ab[2]) / len2);
+    const double tp = ((p->x() - a[0]) * ab[0] + (p->y() - a[1]) * ab[1] + (p->z() - a[2]) * ab[2]) / len2;
+    if (triangles != nullptr)
+      crossed.emplace_back(tp, impl_->face_to_triangle[h.second.idx()]);
+    else
+      t->push_back(tp);
+  }
+  if (triangles != nullptr) {
+    std::sort(crossed.begin(), crossed.end());
+    triangles->clear();
+    for (const auto& [tp, tri] : crossed) t->push_back(tp), triangles->push_back(tri);
   }
   std::sort(t->begin(), t->end());
   // Two hits at the same point mean the segment passes through an edge or a vertex shared by triangles.

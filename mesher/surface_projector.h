@@ -46,8 +46,10 @@ class SurfaceProjector {
 
   // Parameters t in [0, 1] of the points where the segment a + t (b - a) crosses the surface, ascending.
   // Returns false when the segment touches the surface in a degenerate way (along an edge, a vertex or
-  // inside a triangle's plane), where crossing parity would be unreliable.
-  bool segment_crossings(const Vec3& a, const Vec3& b, std::vector<double>* t) const;
+  // inside a triangle's plane), where crossing parity would be unreliable. With `triangles`, also the
+  // crossed triangle of each parameter, in the same order.
+  bool segment_crossings(const Vec3& a, const Vec3& b, std::vector<double>* t,
+                         std::vector<int>* triangles = nullptr) const;
 
   const TriSurface& surface() const { return surface_; }
 
