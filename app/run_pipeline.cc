@@ -241,6 +241,59 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
   return r;
 }
 
+// Every separate body of the mesh (hexes connected through shared nodes: the fragments of a fractured
+// mandible, or parts that the mesher could not join) must be held by supports in x, y and z; a body that
+// nothing holds can move freely, the stiffness matrix is singular, and the solve would end in an
+// equilibrium failure with displacements of 1e12 mm. InputError naming the body and the supports' lines.
+void require_every_body_held(const Scenario& s, const LevelResult& r) {
+  const HexMesh& mesh = r.mesh;
+  std::vector<int> parent(mesh.vertices.size());
+  for (std::size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const auto& hex : mesh.hexes)
+    for (int c = 1; c < 8; ++c) parent[find(hex[c])] = find(hex[0]);
+  std::map<int, int> body_of_root;  // root vertex -> body index, in the order of the first hex
+  std::vector<long> hexes;
+  std::vector<Vec3> centre_sum;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    const auto [it, fresh] = body_of_root.emplace(find(mesh.hexes[h][0]), static_cast<int>(hexes.size()));
+    if (fresh) hexes.push_back(0), centre_sum.push_back({0, 0, 0});
+    ++hexes[it->second];
+    const Vec3 c = hex_centroid(mesh, static_cast<int>(h));
+    for (int a = 0; a < 3; ++a) centre_sum[it->second][a] += c[a];
+  }
+  const int bodies = static_cast<int>(hexes.size());
+  if (bodies < 2) return;
+  std::vector<std::array<bool, 3>> held(bodies, {false, false, false});
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    for (const auto& face : r.support_patches[i].faces)
+      for (int v : face) {
+        std::array<bool, 3>& h = held[body_of_root.at(find(v))];
+        for (int a = 0; a < 3; ++a) h[a] = h[a] || s.supports[i].spring_N_per_mm3 || s.supports[i].fixed[a];
+      }
+  for (int b = 0; b < bodies; ++b) {
+    if (held[b][0] && held[b][1] && held[b][2]) continue;
+    std::string how = "is touched by no support";
+    if (held[b][0] || held[b][1] || held[b][2]) {
+      how = "is held by the supports only in";
+      for (int a = 0; a < 3; ++a)
+        if (held[b][a]) how += std::string(" ") + "xyz"[a];
+    }
+    char text[512];
+    std::snprintf(
+        text, sizeof text,
+        "the mesh has %d separate bodies (parts that share no node), and body %d (%ld hexes, around "
+        "(%.1f, %.1f, %.1f) mm) %s, so it can move freely and the problem is singular: add a "
+        "support on it, or make the geometry one piece",
+        bodies, b + 1, hexes[b], centre_sum[b][0] / hexes[b], centre_sum[b][1] / hexes[b],
+        centre_sum[b][2] / hexes[b], how.c_str());
+    throw InputError(s.supports.empty() ? std::string(text) : s.supports.front().where.str() + ": " + text);
+  }
+}
+
 // Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
 // nodes on the surface) runs up to a millimetre or two inside it, so such a point is often just outside the
 // mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
@@ -358,6 +411,7 @@ RunResult run_pipeline(Scenario scenario, int levels) {
   }
   result.levels.push_back(prepare_level(scenario, 0, coarse));
   result.levels.back().seconds_mesh = seconds_mesh;
+  require_every_body_held(scenario, result.levels.back());  // refinement keeps the bodies
 
   // Every patch of every level is selected before the first solve, so a scenario error never costs a solve.
   std::unique_ptr<SurfaceProjector> projector;

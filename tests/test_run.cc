@@ -380,6 +380,61 @@ TEST(RunScenario, PatchSelectingNoFacetIsRefusedAtItsLine) {
   EXPECT_NE(err.find("bad.yaml:10:"), std::string::npos) << err;  // the line of that support
 }
 
+// Two separate 20 mm cubes (x 0-20 and 40-60) as OBJ text, outward triangles.
+std::string two_cubes_obj() {
+  std::string text;
+  const int faces[12][3] = {{1, 3, 4}, {1, 4, 2}, {5, 6, 8}, {5, 8, 7}, {1, 2, 6}, {1, 6, 5},
+                            {3, 7, 8}, {3, 8, 4}, {1, 5, 7}, {1, 7, 3}, {2, 4, 8}, {2, 8, 6}};
+  for (int cube = 0; cube < 2; ++cube) {
+    for (int v = 0; v < 8; ++v)
+      text += "v " + std::to_string(40 * cube + 20 * (v & 1)) + " " + std::to_string(20 * ((v >> 1) & 1)) +
+              " " + std::to_string(20 * ((v >> 2) & 1)) + "\n";
+    for (const auto& f : faces)
+      text += "f " + std::to_string(f[0] + 8 * cube) + " " + std::to_string(f[1] + 8 * cube) + " " +
+              std::to_string(f[2] + 8 * cube) + "\n";
+  }
+  return text;
+}
+
+// A geometry of two separate bodies (the fragments of a fractured mandible, say) with supports on one only:
+// the other could move freely. Refused before the solve, naming that body; before, the solve ran and
+// failed its equilibrium check with displacements of 1e12 mm and the advice to tighten the tolerance.
+TEST(RunScenario, BodyThatNoSupportHoldsIsRefused) {
+  const std::string scenario = R"(name: two_bodies
+geometry:
+  surface: {file: two_cubes.obj}
+mesh: {target_hexes: 1500, validation_levels: 0}
+muscles:
+  - {name: pull, activation: 1, insertion: [60, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
+supports:
+  - {name: base, at: [0, 10, 10], radius_mm: 5}
+outputs: {bite_force: false}
+)";
+  const std::string path = write_scenario(scenario);
+  test::write_file(fs::path(path).parent_path().string() + "/two_cubes.obj", two_cubes_obj());
+  const std::string dir = test::temp_dir() + "/out";
+  test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(path + ":8:"), std::string::npos) << r.err;  // the supports
+  EXPECT_NE(r.err.find("the mesh has 2 separate bodies"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("is touched by no support"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir));
+  // Held in x only: still free in y and z.
+  std::string partly = scenario;
+  partly.replace(partly.find("outputs"), 0,
+                 "  - {name: other, at: [40, 10, 10], radius_mm: 5, fixed: [x]}\n");
+  test::write_file(path, partly);
+  r = test::run_hexbite({"-q", "run", path, "-o", dir});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("is held by the supports only in x,"), std::string::npos) << r.err;
+  // Held in every direction: solved, in equilibrium.
+  std::string held = scenario;
+  held.replace(held.find("outputs"), 0, "  - {name: other, at: [40, 10, 10], radius_mm: 5}\n");
+  test::write_file(path, held);
+  const json j = run_scenario(path, dir);
+  EXPECT_LT(j["equilibrium_residual"].get<double>(), 1e-8);
+}
+
 TEST(RunScenario, UnknownKeyIsRefused) {
   expect_refused(kSmall + "solvr: {degree: 1}\n", "did you mean 'solver'?");
 }
