@@ -5,6 +5,7 @@
 // problem goes to standard error and the exit code is 2; the repaired surface is written only when
 // the surface is usable, so a failed check never leaves an output file behind.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -145,6 +146,13 @@ void run_check(const CheckOptions& o) {
   } else {
     info(report_text(report) + (write ? "\nwrote the repaired surface to " + o.output : ""));
   }
+
+  // Not a problem of the surface, but the likeliest way to get every later number wrong by 1000.
+  const std::string size_warning = implausible_size_warning(
+      std::max({report.bbox_max[0] - report.bbox_min[0], report.bbox_max[1] - report.bbox_min[1],
+                report.bbox_max[2] - report.bbox_min[2]}),
+      "give --units m");
+  if (!size_warning.empty()) std::cerr << "hexbite: warning: '" << o.file << "': " << size_warning << '\n';
 
   if (!report.usable()) {
     for (const auto& p : report.problems) std::cerr << "hexbite: error: '" << o.file << "': " << p << '\n';

@@ -1,5 +1,6 @@
 // `hexbite surface from-ct`: the iso-surface of a CT volume, the first step of the seed paper's pipeline.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "common/progress.h"
 #include "mesher/ct_surface.h"
 #include "mesher/surface_io.h"
+#include "mesher/units.h"
 
 namespace hexbite {
 
@@ -31,7 +33,14 @@ void run_from_ct(const FromCtArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress("extract surface");
   const VoxelVolume volume = read_volume(args.volume);
-  const TriSurface surface = surface_from_volume(volume, args.threshold);
+  CtExtraction dropped;
+  TriSurface surface;
+  try {
+    surface = surface_from_volume(volume, args.threshold, &dropped);
+  } catch (const InputError& e) {
+    // The threshold's messages speak of "the volume": say which file.
+    throw InputError("'" + args.volume + "': " + e.what());
+  }
   progress.finish();
   write_surface(args.output, surface);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -53,6 +62,16 @@ void run_from_ct(const FromCtArgs& args) {
                 surface.triangles.size(), surface.vertices.size(), six_volume / 6000.0, seconds);
   info(buf);
   info("wrote " + args.output);
+  // A volume whose spacing is in metres gives a bone a thousand times too small.
+  const std::string size_warning = implausible_size_warning(
+      largest_extent(surface),
+      "give the volume its spacing in millimetres (MetaImage has no unit of its own)");
+  if (!size_warning.empty())
+    std::fprintf(stderr, "hexbite: warning: '%s': %s.\n", args.volume.c_str(), size_warning.c_str());
+  // Only the largest piece is kept; what else the threshold found must not vanish without a word
+  // (a second bone or a fracture fragment, a marrow cavity that is now solid).
+  for (const std::string& sentence : describe_dropped(dropped, args.threshold))
+    std::fprintf(stderr, "hexbite: warning: '%s': %s.\n", args.volume.c_str(), sentence.c_str());
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -20,6 +22,8 @@
 #include "mesher/mandible_sheet_mesher.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
+#include "mesher/units.h"
+#include "solver/mpi_session.h"
 
 namespace hexbite {
 
@@ -34,6 +38,11 @@ struct Geometry {
   Landmarks landmarks;
 };
 
+// A warning on standard error, from rank 0 only (every rank builds the same geometry).
+void warn(const std::string& line) {
+  if (MpiSession::rank() == 0) std::cerr << "hexbite: warning: " << line << ".\n";
+}
+
 Geometry build_geometry(const Scenario& s) {
   Geometry g;
   switch (s.geometry.source) {
@@ -47,7 +56,18 @@ Geometry build_geometry(const Scenario& s) {
       g.surface = load_closed_surface(s.geometry.file, s.geometry.scale_to_mm);
       break;
     case GeometrySource::kCt: {
-      g.surface = surface_from_volume(read_volume(s.geometry.file), s.geometry.threshold);
+      CtExtraction dropped;
+      try {
+        g.surface = surface_from_volume(read_volume(s.geometry.file), s.geometry.threshold, &dropped);
+      } catch (const InputError& e) {
+        const std::string what = e.what();
+        // read_volume names the file; the threshold's messages speak of "the volume".
+        throw InputError(s.geometry.where.str() + ": " +
+                         (what.find(s.geometry.file) == std::string::npos ? s.geometry.file + ": " : "") +
+                         what);
+      }
+      for (const std::string& sentence : describe_dropped(dropped, s.geometry.threshold))
+        warn(s.geometry.file + ": " + sentence);
       // Marching cubes gives a closed surface by construction, but the same checks as for a surface file
       // catch a threshold that produced something that cannot bound a solid.
       const SurfaceReport report = check_surface(g.surface, s.geometry.file);
@@ -57,6 +77,11 @@ Geometry build_geometry(const Scenario& s) {
                          " cannot bound a solid: " + report.problems.front() + "; try another threshold");
       break;
     }
+  }
+  if (s.geometry.source == GeometrySource::kSurface && !g.surface.vertices.empty()) {
+    const std::string size_warning =
+        implausible_size_warning(largest_extent(g.surface), "add units: m to geometry.surface");
+    if (!size_warning.empty()) warn(s.geometry.where.str() + ": " + s.geometry.file + ": " + size_warning);
   }
   if (!s.landmarks.file.empty()) g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
   return g;
@@ -234,9 +259,38 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
     r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm, sup.where,
                                              "support '" + sup.name + "'"));
   r.hex_material.reserve(r.mesh.hexes.size());
+  // A hex takes a region's material by its centre; a region that wins no hex changes nothing, which
+  // must not pass for a simulated implant or resorption site. Checked on the coarse mesh (finer levels
+  // only add hexes inside the same bone).
+  const std::size_t regions = s.materials.regions.size();
+  std::vector<int> hexes_of_region(regions, 0);
+  std::vector<double> nearest_centre(regions, std::numeric_limits<double>::infinity());
   for (std::size_t h = 0; h < r.mesh.hexes.size(); ++h) {
-    const MaterialSpec m = material_at(s.materials, hex_centroid(r.mesh, static_cast<int>(h)));
+    const Vec3 centre = hex_centroid(r.mesh, static_cast<int>(h));
+    const int region = region_at(s.materials, centre);
+    const MaterialSpec& m = region < 0 ? s.materials.default_material
+                                       : s.materials.regions[static_cast<std::size_t>(region)].material;
     r.hex_material.push_back({m.E_MPa, m.poisson});
+    if (region >= 0) ++hexes_of_region[static_cast<std::size_t>(region)];
+    for (std::size_t i = 0; i < regions && level == 0; ++i)
+      nearest_centre[i] = std::min(nearest_centre[i], distance_outside(s.materials.regions[i], centre));
+  }
+  for (std::size_t i = 0; i < regions && level == 0; ++i) {
+    if (hexes_of_region[i] > 0) continue;
+    const MaterialRegion& region = s.materials.regions[i];
+    char buf[300];
+    if (nearest_centre[i] > 0)
+      std::snprintf(
+          buf, sizeof buf,
+          "the nearest hex centre is %.1f mm outside it: move it into the bone or enlarge it, or make "
+          "the mesh finer (mesh.target_hexes)",
+          nearest_centre[i]);
+    else
+      std::snprintf(buf, sizeof buf,
+                    "every hex centre inside it takes the material of a later region that overlaps it: "
+                    "reorder or reshape the regions");
+    throw InputError(region.where.str() + ": material region '" + region.name + "' holds no hex of the " +
+                     std::to_string(r.mesh.hexes.size()) + "-hex mesh, so it would change nothing; " + buf);
   }
   return r;
 }
@@ -294,11 +348,13 @@ void require_every_body_held(const Scenario& s, const LevelResult& r) {
   }
 }
 
+constexpr double kProbeMaxOutsideMm = 5.0;
+
 // Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
 // nodes on the surface) runs up to a millimetre or two inside it, so such a point is often just outside the
 // mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
 // centre of the hex behind it, so that one hex contains it; results.json reports the requested point and
-// the distance moved.
+// the distance moved. A point farther outside than kProbeMaxOutsideMm is refused at its line.
 std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Probe>& probes) {
   std::vector<Vec3> points;
   if (probes.empty()) return points;
@@ -311,6 +367,22 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Pr
       continue;
     }
     const SurfacePoint foot = mesh_boundary.closest(p);
+    // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
+    // away is a typo or a point of another frame, and its values would be those of an unrelated place.
+    const double outside = std::sqrt((foot.point[0] - p[0]) * (foot.point[0] - p[0]) +
+                                     (foot.point[1] - p[1]) * (foot.point[1] - p[1]) +
+                                     (foot.point[2] - p[2]) * (foot.point[2] - p[2]));
+    if (outside > kProbeMaxOutsideMm) {
+      char buf[400];
+      std::snprintf(
+          buf, sizeof buf,
+          ": probe '%s' at (%.2f, %.2f, %.2f) lies %.1f mm outside the mesh (nearest boundary point "
+          "(%.2f, %.2f, %.2f)); a probe must be in the bone or within %.0f mm of it: check its "
+          "coordinates and units",
+          probe.name.c_str(), p[0], p[1], p[2], outside, foot.point[0], foot.point[1], foot.point[2],
+          kProbeMaxOutsideMm);
+      throw InputError(probe.where.str() + buf);
+    }
     const Vec3 centre = hex_centroid(mesh, boundary.quad_face[foot.triangle / 4][0]);
     Vec3 moved;
     for (int a = 0; a < 3; ++a) moved[a] = foot.point[a] + 0.01 * (centre[a] - foot.point[a]);

@@ -11,6 +11,7 @@
 #include <vtkMatrix4x4.h>
 #include <vtkMetaImageReader.h>
 #include <vtkMetaImageWriter.h>
+#include <vtkNIFTIImageHeader.h>
 #include <vtkNIFTIImageReader.h>
 #include <vtkNIFTIImageWriter.h>
 #include <vtkPointData.h>
@@ -22,8 +23,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <vector>
 
 #include "common/error.h"
 #include "common/paths.h"
@@ -129,6 +134,49 @@ void flip_axis(VoxelVolume& v, int axis) {
       }
 }
 
+// VTK's MetaImage reader ignores the grid's direction (TransformMatrix, also spelled Rotation or
+// Orientation) and the sign of ElementSpacing, so both are read from the text header here and
+// turned into an orientation matrix like NIfTI's qform: a grid stored with a flipped or rotated
+// axis would otherwise come out mirrored or in the wrong place without a word.
+vtkSmartPointer<vtkMatrix4x4> metaimage_orientation(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::array<double, 9> m = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  std::array<double, 3> sign = {1, 1, 1};
+  int dims = 3;  // NDims comes before the matrix in every MetaImage header
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    std::string key = line.substr(0, eq);
+    key.erase(std::remove_if(key.begin(), key.end(), [](unsigned char c) { return std::isspace(c); }),
+              key.end());
+    std::istringstream values(line.substr(eq + 1));
+    if (key == "NDims") {
+      if (!(values >> dims) || dims < 1 || dims > 3) dims = 3;  // VTK's reader judges the rest
+    } else if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation") {
+      m = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      for (int r = 0; r < dims; ++r)
+        for (int c = 0; c < dims; ++c)
+          if (!(values >> m[3 * r + c]))
+            throw InputError("'" + path + "' header line " + std::to_string(n + 1) + ": " + key +
+                             " must hold " + std::to_string(dims * dims) + " numbers (the " +
+                             std::to_string(dims) + " x " + std::to_string(dims) + " direction matrix)");
+    } else if (key == "ElementSpacing") {
+      for (int a = 0; a < dims; ++a) {
+        double x = 1;
+        if (values >> x) sign[a] = x < 0 ? -1 : 1;
+      }
+    }
+    if (key == "ElementDataFile") break;
+  }
+  auto matrix = vtkSmartPointer<vtkMatrix4x4>::New();
+  // MetaImage stores the matrix row by row with the direction of axis i in row i (ITK's
+  // convention); the placement is Offset + sum_i index_i spacing_i row_i.
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) matrix->SetElement(r, c, m[3 * c + r] * sign[c]);
+  return matrix;
+}
+
 }  // namespace
 
 VoxelVolume read_volume(const std::string& path) {
@@ -140,6 +188,7 @@ VoxelVolume read_volume(const std::string& path) {
   vtkSmartPointer<vtkImageData> image;
   vtkSmartPointer<vtkMatrix4x4> orientation;
   double slope = 1, intercept = 0;
+  double length_scale = 1;  // to millimetres
   if (fmt.format == VolumeFormat::kMetaImage) {
     auto reader = vtkSmartPointer<vtkMetaImageReader>::New();
     errors.watch(reader);
@@ -148,6 +197,7 @@ VoxelVolume read_volume(const std::string& path) {
     reader->SetFileName(path.c_str());
     reader->Update();
     image = reader->GetOutput();
+    orientation = metaimage_orientation(path);
   } else {
     auto reader = vtkSmartPointer<vtkNIFTIImageReader>::New();
     errors.watch(reader);
@@ -163,6 +213,19 @@ VoxelVolume read_volume(const std::string& path) {
       slope = reader->GetRescaleSlope();
       intercept = reader->GetRescaleIntercept();
     }
+    // NIfTI may give lengths in metres or micrometres (xyzt_units); hexbite works in millimetres.
+    if (vtkNIFTIImageHeader* header = reader->GetNIFTIHeader()) {
+      switch (header->GetXYZTUnits() & 0x07) {
+        case vtkNIFTIImageHeader::UnitsMeter:
+          length_scale = 1000;
+          break;
+        case vtkNIFTIImageHeader::UnitsMicron:
+          length_scale = 0.001;
+          break;
+        default:
+          break;  // millimetres, or unknown (0): taken as millimetres
+      }
+    }
   }
   if (!errors.message.empty() || !image || !image->GetPointData()->GetScalars())
     throw InputError("cannot read volume '" + path + "'" +
@@ -177,8 +240,15 @@ VoxelVolume read_volume(const std::string& path) {
   image->GetDimensions(dims);
   v.dims = {dims[0], dims[1], dims[2]};
   const double* sp = image->GetSpacing();
-  const double* org = image->GetOrigin();
+  double org[3] = {image->GetOrigin()[0], image->GetOrigin()[1], image->GetOrigin()[2]};
   v.origin = {org[0], org[1], org[2]};
+  if (fmt.format == VolumeFormat::kMetaImage) {
+    // MetaImage: the Offset is the first voxel's position, the direction applies from there.
+    for (int a = 0; a < 3; ++a) {
+      orientation->SetElement(a, 3, org[a]);
+      org[a] = 0;
+    }
+  }
   v.axis_spacing = {std::abs(sp[0]), std::abs(sp[1]), std::abs(sp[2])};
   v.spacing = v.axis_spacing[0];
   const vtkIdType n = scalars->GetNumberOfTuples();
@@ -193,15 +263,16 @@ VoxelVolume read_volume(const std::string& path) {
   if (orientation) {
     // Axis-aligned placements (possibly with reversed axes) are turned into a plain origin;
     // a rotated grid would need resampling, which is the job of a dedicated imaging tool.
+    // Off-diagonal terms first: a rotation by 90 degrees has zeros on the diagonal and must be
+    // called a rotation, not a scaling.
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        const double m = orientation->GetElement(r, c);
-        if (r != c && std::abs(m) > 1e-6)
+      for (int c = 0; c < 3; ++c)
+        if (r != c && std::abs(orientation->GetElement(r, c)) > 1e-6)
           throw InputError("volume '" + path +
                            "' is stored in a rotated orientation; resample it to an axis-aligned grid first");
-        if (r == c && std::abs(std::abs(m) - 1) > 1e-6)
-          throw InputError("volume '" + path + "' has a scaled orientation matrix; it is not supported");
-      }
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(std::abs(orientation->GetElement(a, a)) - 1) > 1e-6)
+        throw InputError("volume '" + path + "' has a scaled orientation matrix; it is not supported");
     for (int a = 0; a < 3; ++a) {
       const double t = orientation->GetElement(a, 3) + orientation->GetElement(a, a) * org[a];
       if (orientation->GetElement(a, a) < 0) {
@@ -211,6 +282,13 @@ VoxelVolume read_volume(const std::string& path) {
         v.origin[a] = t;
       }
     }
+  }
+  if (length_scale != 1) {
+    for (int a = 0; a < 3; ++a) {
+      v.origin[a] *= length_scale;
+      v.axis_spacing[a] *= length_scale;
+    }
+    v.spacing = v.axis_spacing[0];
   }
   if (std::abs(v.axis_spacing[1] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0] &&
       std::abs(v.axis_spacing[2] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0])
@@ -270,18 +348,31 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
   }
 }
 
-TriSurface surface_from_volume(const VoxelVolume& volume, double threshold) {
+TriSurface surface_from_volume(const VoxelVolume& volume, double threshold, CtExtraction* dropped) {
   check_volume(volume);
   if (!std::isfinite(threshold)) throw InputError("the threshold must be a finite number");
-  const auto [lo, hi] = std::minmax_element(volume.values.begin(), volume.values.end());
+  // Voxels without a value (NaN, as some exporters store outside the field of view) take no part
+  // in the range.
+  float lo_value = std::numeric_limits<float>::infinity(), hi_value = -lo_value;
+  for (float x : volume.values)
+    if (std::isfinite(x)) {
+      lo_value = std::min(lo_value, x);
+      hi_value = std::max(hi_value, x);
+    }
+  const float* lo = &lo_value;
+  const float* hi = &hi_value;
   if (!(*hi > threshold))
     throw InputError("nothing in the volume exceeds the threshold " + std::to_string(threshold) +
                      " (values range from " + std::to_string(*lo) + " to " + std::to_string(*hi) +
                      "); choose a lower threshold");
+  if (!(*lo < threshold))
+    throw InputError("every voxel of the volume is at or above the threshold " + std::to_string(threshold) +
+                     " (values range from " + std::to_string(*lo) + " to " + std::to_string(*hi) +
+                     "): the surface would be the box of the whole scan, not the bone; choose a higher "
+                     "threshold");
   // One voxel of background around the grid closes the iso-surface where the object touches the
   // border of the scan, so the result always bounds a solid.
-  const float background =
-      *lo < threshold ? *lo : static_cast<float>(threshold - std::max(1.0, std::abs(threshold)));
+  const float background = *lo;
   auto image = to_image(volume, 1, background);
 
   auto contour = vtkSmartPointer<vtkFlyingEdges3D>::New();
@@ -297,6 +388,53 @@ TriSurface surface_from_volume(const VoxelVolume& volume, double threshold) {
   auto largest = vtkSmartPointer<vtkPolyDataConnectivityFilter>::New();
   largest->SetInputConnection(contour->GetOutputPort());
   largest->SetExtractionModeToLargestRegion();
+
+  if (dropped) {
+    *dropped = CtExtraction{};
+    auto all = vtkSmartPointer<vtkPolyDataConnectivityFilter>::New();
+    all->SetInputConnection(contour->GetOutputPort());
+    all->SetExtractionModeToAllRegions();
+    all->ColorRegionsOn();
+    all->Update();
+    vtkPolyData* pieces = all->GetOutput();
+    const int regions = all->GetNumberOfExtractedRegions();
+    // ColorRegions labels the points; every point of a triangle is in the triangle's region.
+    vtkDataArray* region_of_point = pieces->GetPointData()->GetArray("RegionId");
+    if (regions > 1 && region_of_point) {
+      std::vector<double> six_volume(static_cast<std::size_t>(regions), 0.0);
+      std::vector<vtkIdType> cells(static_cast<std::size_t>(regions), 0);
+      vtkCellArray* tris = pieces->GetPolys();
+      vtkIdType npts = 0;
+      const vtkIdType* ids = nullptr;
+      for (tris->InitTraversal(); tris->GetNextCell(npts, ids);) {
+        if (npts != 3) continue;
+        const auto r = static_cast<std::size_t>(region_of_point->GetComponent(ids[0], 0));
+        if (r >= six_volume.size()) continue;
+        double a[3], b[3], c[3];
+        pieces->GetPoint(ids[0], a);
+        pieces->GetPoint(ids[1], b);
+        pieces->GetPoint(ids[2], c);
+        six_volume[r] += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                         a[2] * (b[0] * c[1] - b[1] * c[0]);
+        ++cells[r];
+      }
+      // The kept piece is the one with the most triangles, as vtkPolyDataConnectivityFilter picks it.
+      const auto kept =
+          static_cast<std::size_t>(std::max_element(cells.begin(), cells.end()) - cells.begin());
+      dropped->kept_mm3 = std::abs(six_volume[kept]) / 6;
+      for (std::size_t r = 0; r < six_volume.size(); ++r) {
+        if (r == kept || cells[r] == 0) continue;
+        const double v = std::abs(six_volume[r]) / 6;
+        if ((six_volume[r] > 0) == (six_volume[kept] > 0)) {
+          ++dropped->dropped_bodies;
+          dropped->largest_dropped_body_mm3 = std::max(dropped->largest_dropped_body_mm3, v);
+        } else {
+          ++dropped->dropped_cavities;
+          dropped->largest_dropped_cavity_mm3 = std::max(dropped->largest_dropped_cavity_mm3, v);
+        }
+      }
+    }
+  }
 
   auto clean = vtkSmartPointer<vtkCleanPolyData>::New();
   clean->SetInputConnection(largest->GetOutputPort());
@@ -344,6 +482,31 @@ TriSurface surface_from_volume(const VoxelVolume& volume, double threshold) {
   if (six_volume < 0)
     for (auto& t : s.triangles) std::swap(t[1], t[2]);
   return s;
+}
+
+std::vector<std::string> describe_dropped(const CtExtraction& dropped, double threshold) {
+  std::vector<std::string> out;
+  const double kept = std::max(dropped.kept_mm3, 1e-300);
+  char buf[600];
+  if (dropped.dropped_bodies > 0) {
+    std::snprintf(
+        buf, sizeof buf,
+        "kept only the largest piece (%.2f cm^3); dropped %d separate piece(s) at threshold %g, the "
+        "largest enclosing %.2f cm^3 (%.1f%% of the kept one). If that is bone (a second bone, a "
+        "fragment), crop the volume to one bone or raise the threshold; small ones are usually noise",
+        dropped.kept_mm3 / 1000, dropped.dropped_bodies, threshold, dropped.largest_dropped_body_mm3 / 1000,
+        100 * dropped.largest_dropped_body_mm3 / kept);
+    out.push_back(buf);
+  }
+  if (dropped.dropped_cavities > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "filled %d enclosed cavit%s below threshold %g (the largest %.2f cm^3, %.1f%% of the kept "
+                  "piece): the surface is the outer wall only",
+                  dropped.dropped_cavities, dropped.dropped_cavities == 1 ? "y" : "ies", threshold,
+                  dropped.largest_dropped_cavity_mm3 / 1000, 100 * dropped.largest_dropped_cavity_mm3 / kept);
+    out.push_back(buf);
+  }
+  return out;
 }
 
 }  // namespace hexbite

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "mesher/mandible_generator.h"
 #include "mesher/tri_surface.h"
@@ -11,8 +12,25 @@ namespace hexbite {
 // Reads MetaImage (.mha/.mhd) or NIfTI (.nii/.nii.gz); throws InputError naming the file otherwise.
 VoxelVolume read_volume(const std::string& path);
 
+// What the extraction left out: the iso-surface's other connected pieces, told apart by the sign
+// of their enclosed volume (marching cubes orients every piece the same way relative to the
+// values, so a cavity's wall encloses a volume of the opposite sign to a body's).
+struct CtExtraction {
+  double kept_mm3 = 0;     // volume enclosed by the kept (largest) piece
+  int dropped_bodies = 0;  // separate pieces of material (fragments, a second bone)
+  double largest_dropped_body_mm3 = 0;
+  int dropped_cavities = 0;  // walls of enclosed pockets below the threshold (now filled)
+  double largest_dropped_cavity_mm3 = 0;
+};
+
 // Iso-surface at `threshold` with marching cubes; keeps the largest connected component, merges
-// duplicate points and orients it outward. Throws InputError if nothing in the volume exceeds it.
-TriSurface surface_from_volume(const VoxelVolume& volume, double threshold);
+// duplicate points and orients it outward. Throws InputError if nothing in the volume exceeds it,
+// or if every voxel does (the surface would be the box of the scan). `dropped`, when given,
+// receives what was left out.
+TriSurface surface_from_volume(const VoxelVolume& volume, double threshold, CtExtraction* dropped = nullptr);
+
+// One sentence per kind of piece left out ("kept only the largest piece ...", "filled 2 enclosed
+// cavities ..."), for a warning; empty when nothing was dropped.
+std::vector<std::string> describe_dropped(const CtExtraction& dropped, double threshold);
 
 }  // namespace hexbite

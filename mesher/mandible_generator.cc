@@ -726,7 +726,27 @@ GeneratedMandible generate_mandible(const MandibleParameters& parameters) {
   }
 
   out.threshold = 0.5 * (kBoneHU + kSoftTissueHU);
-  out.surface = surface_from_volume(ct, out.threshold);
+  CtExtraction dropped;
+  out.surface = surface_from_volume(ct, out.threshold, &dropped);
+  // Each option alone keeps the model a single genus-0 solid, but some corners of the ranges together
+  // (a short, wide ramus at a large gonial angle) make its parts close around an opening or come
+  // apart; such a bone is not a mandible and must not be simulated as one. For a closed triangle
+  // surface E = 3F/2, so V - F/2 is its Euler characteristic, 2 for a sphere-like surface.
+  const long long euler = static_cast<long long>(out.surface.vertices.size()) -
+                          static_cast<long long>(out.surface.triangles.size()) / 2;
+  if (euler != 2 || dropped.dropped_bodies > 0) {
+    const std::string shape = dropped.dropped_bodies > 0
+                                  ? "in " + std::to_string(dropped.dropped_bodies + 1) + " separate pieces"
+                                  : "with " + std::to_string((2 - euler) / 2) + " hole(s) through it";
+    char buf[700];
+    std::snprintf(buf, sizeof buf,
+                  "the mandible dimensions arch width %g, arch depth %g, body height %g, body thickness %g, "
+                  "ramus height %g, ramus width %g mm, gonial angle %g deg give a bone %s, not a single "
+                  "solid without holes; move the extreme values toward the variant's defaults",
+                  p.arch_width_mm, p.arch_depth_mm, p.body_height_mm, p.body_thickness_mm, p.ramus_height_mm,
+                  p.ramus_width_mm, p.gonial_angle_deg, shape.c_str());
+    throw InputError(buf);
+  }
   out.landmarks = make_landmarks(m, out.surface);
   return out;
 }

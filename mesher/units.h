@@ -9,4 +9,10 @@ namespace hexbite {
 // Throws InputError naming the accepted units for anything else.
 double unit_to_mm(const std::string& unit);
 
+// A sentence for a warning when a bone's size in millimetres (the largest side of its bounding
+// box, after the unit conversion) says the unit was probably wrong: under 0.5 mm (a bone exported
+// in metres and read as mm; `fix` says how to give the unit) or over 3000 mm (micrometres).
+// Empty for plausible sizes.
+std::string implausible_size_warning(double largest_extent_mm, const std::string& fix);
+
 }  // namespace hexbite

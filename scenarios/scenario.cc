@@ -858,16 +858,31 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
   }
 }
 
-MaterialSpec material_at(const Materials& materials, const Vec3& x) {
-  for (auto it = materials.regions.rbegin(); it != materials.regions.rend(); ++it) {
-    const MaterialRegion& r = *it;
+int region_at(const Materials& materials, const Vec3& x) {
+  for (int i = static_cast<int>(materials.regions.size()) - 1; i >= 0; --i) {
+    const MaterialRegion& r = materials.regions[static_cast<std::size_t>(i)];
     const bool inside = r.shape == RegionShape::kSphere
                             ? distance(x, r.center.xyz) <= r.radius_mm
                             : (x[0] >= r.min.xyz[0] && x[0] <= r.max.xyz[0] && x[1] >= r.min.xyz[1] &&
                                x[1] <= r.max.xyz[1] && x[2] >= r.min.xyz[2] && x[2] <= r.max.xyz[2]);
-    if (inside) return r.material;
+    if (inside) return i;
   }
-  return materials.default_material;
+  return -1;
+}
+
+MaterialSpec material_at(const Materials& materials, const Vec3& x) {
+  const int i = region_at(materials, x);
+  return i < 0 ? materials.default_material : materials.regions[static_cast<std::size_t>(i)].material;
+}
+
+double distance_outside(const MaterialRegion& r, const Vec3& x) {
+  if (r.shape == RegionShape::kSphere) return std::max(0.0, distance(x, r.center.xyz) - r.radius_mm);
+  double sum = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::max({r.min.xyz[k] - x[k], 0.0, x[k] - r.max.xyz[k]});
+    sum += d * d;
+  }
+  return std::sqrt(sum);
 }
 
 Vec3 muscle_force(const Muscle& muscle) {

@@ -175,6 +175,13 @@ void resolve_points(Scenario& scenario, const Landmarks& landmarks);
 // The material at a point (after resolve_points): the last region containing it, else the default.
 MaterialSpec material_at(const Materials& materials, const Vec3& x);
 
+// The index of the region whose material applies at a point (the last one containing it), or -1 for the
+// default material.
+int region_at(const Materials& materials, const Vec3& x);
+
+// How far a point lies outside a region (0 inside), in mm.
+double distance_outside(const MaterialRegion& region, const Vec3& x);
+
 // A muscle's force vector in N (after resolve_points): activation x max force along the line of action.
 Vec3 muscle_force(const Muscle& muscle);
 

@@ -129,6 +129,29 @@ TEST(Cli, TextReportAndQuiet) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// A 20 mm cube exported in metres and read without --units is a usable 0.02 mm cube: nothing in the
+// report was wrong, but every later length, stress and volume would be off by 1000. Warned about.
+TEST(Cli, SurfaceInMetresWithoutUnitsIsWarnedAbout) {
+  std::string metres;
+  for (int v = 0; v < 8; ++v)
+    metres += "v " + std::to_string(0.02 * (v & 1)) + " " + std::to_string(0.02 * ((v >> 1) & 1)) + " " +
+              std::to_string(0.02 * ((v >> 2) & 1)) + "\n";
+  for (const char* f : kCubeFaces) metres += f;
+  const std::string path = write_case("metres.obj", metres);
+  auto r = run_hexbite({"surface", "check", path});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: '" + path + "': the surface is only 0.02 mm across"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("give --units m"), std::string::npos) << r.err;
+  r = run_hexbite({"surface", "check", path, "--units", "m"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  // The unit cube of the other tests is small but plausible: no warning.
+  r = run_hexbite({"surface", "check", write_case("cube.obj", cube_obj())});
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
 TEST(Cli, RepairedSurfaceIsWrittenInMillimetres) {
   // An inward cube in cm: flipped, scaled to mm and written; the written file checks clean.
   std::string inward = kCubeVertices;

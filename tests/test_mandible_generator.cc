@@ -4,7 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "common/error.h"
 #include "mesher/ct_surface.h"
@@ -338,6 +342,30 @@ TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
   EXPECT_THROW(read_landmarks(test::temp_dir() + "/missing.yaml"), InputError);
 }
 
+// Every option within its range, but together a short, wide ramus at the largest gonial angle made a bone
+// of genus 2 (an opening through each ramus), written with exit 0 as if it were a mandible.
+TEST(MandibleGenerator, DimensionsThatGiveABoneWithHolesAreRefused) {
+  MandibleParameters p;
+  p.ramus_height_mm = 40;
+  p.ramus_width_mm = 40;
+  p.gonial_angle_deg = 140;
+  try {
+    generate_mandible(p);
+    ADD_FAILURE() << "a mandible with holes through it was generated";
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("ramus height 40, ramus width 40 mm, gonial angle 140 deg give a bone "
+                                   "with 2 hole(s) through it"),
+        std::string::npos)
+        << e.what();
+  }
+  p.ramus_height_mm = 45;  // one step back from the corner: a genus-0 mandible again
+  TriSurface ok = generate_mandible(p).surface;
+  const SurfaceReport r = check_surface(ok);
+  EXPECT_TRUE(r.usable());
+  EXPECT_EQ(r.genus, 0);
+}
+
 TEST(CtVolume, WritesAndReadsMetaImageAndNifti) {
   const VoxelVolume& ct = generated(MandibleVariant::kAtrophic).ct;
   for (const char* name : {"jaw.mha", "jaw.mhd", "jaw.nii", "jaw.nii.gz"}) {
@@ -371,10 +399,163 @@ TEST(CtVolume, SurfaceFromVolumeMatchesTheGeneratorAndRejectsHighThresholds) {
   // An object touching the border of the scan is still closed (the volume is padded).
   VoxelVolume full = g.ct;
   std::fill(full.values.begin(), full.values.end(), 1000.0f);
+  full.values[0] = 0.0f;
   TriSurface box = surface_from_volume(full, 500.0);
   const SurfaceReport r = check_surface(box);
   EXPECT_TRUE(r.closed);
   EXPECT_EQ(r.genus, 0);
+}
+
+// A small volume that is not symmetric along any axis: value i + 10 j + 100 k.
+VoxelVolume ramp_volume() {
+  VoxelVolume v;
+  v.dims = {4, 3, 2};
+  v.origin = {10, 20, 30};
+  v.spacing = 0.5;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) v.values.push_back(static_cast<float>(i + 10 * j + 100 * k));
+  return v;
+}
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+void replace_once(std::string& s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  s.replace(at, from.size(), to);
+}
+
+TEST(CtVolume, MetaImageDirectionAndNegativeSpacingAreHonouredOrRefused) {
+  const std::string dir = test::temp_dir();
+  write_volume(dir + "/ramp.mha", ramp_volume());
+  const std::string plain = read_bytes(dir + "/ramp.mha");
+  // VTK's reader ignores the direction; a flipped x axis must come out mirrored and placed from
+  // the Offset towards -x, not silently as the identity.
+  std::string flipped = plain;
+  replace_once(flipped, "TransformMatrix = 1 0 0 0 1 0 0 0 1", "TransformMatrix = -1 0 0 0 1 0 0 0 1");
+  write_bytes(dir + "/flipped.mha", flipped);
+  const VoxelVolume f = read_volume(dir + "/flipped.mha");
+  EXPECT_NEAR(f.origin[0], 10 - 3 * 0.5, 1e-9);
+  EXPECT_NEAR(f.origin[1], 20, 1e-9);
+  EXPECT_NEAR(f.origin[2], 30, 1e-9);
+  ASSERT_EQ(f.values.size(), 24u);
+  EXPECT_EQ(f.values[0], 3.0f);  // voxel (3, 0, 0) of the file is now the lowest x
+  EXPECT_EQ(f.values[3], 0.0f);
+  EXPECT_EQ(f.values[23], 120.0f);
+  // A negative spacing points the axis backwards in the same way.
+  std::string negative = plain;
+  replace_once(negative, "ElementSpacing = 0.5 0.5 0.5", "ElementSpacing = 0.5 0.5 -0.5");
+  write_bytes(dir + "/negative.mha", negative);
+  const VoxelVolume n = read_volume(dir + "/negative.mha");
+  EXPECT_NEAR(n.origin[2], 30 - 0.5, 1e-9);
+  EXPECT_NEAR(n.spacing_xyz()[2], 0.5, 1e-12);
+  EXPECT_EQ(n.values[0], 100.0f);
+  // A rotated grid would need resampling: refused, naming the file.
+  std::string rotated = plain;
+  replace_once(rotated, "TransformMatrix = 1 0 0 0 1 0 0 0 1", "TransformMatrix = 0 1 0 -1 0 0 0 0 1");
+  write_bytes(dir + "/rotated.mha", rotated);
+  try {
+    read_volume(dir + "/rotated.mha");
+    ADD_FAILURE() << "a rotated MetaImage grid was read as axis-aligned";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rotated.mha' is stored in a rotated orientation"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(CtVolume, NiftiLengthsInMetresOrMicrometresAreConvertedToMillimetres) {
+  const std::string dir = test::temp_dir();
+  write_volume(dir + "/ramp.nii", ramp_volume());
+  const std::string mm = read_bytes(dir + "/ramp.nii");
+  ASSERT_GT(mm.size(), 348u);
+  const VoxelVolume as_mm = read_volume(dir + "/ramp.nii");
+  EXPECT_NEAR(as_mm.spacing_xyz()[0], 0.5, 1e-9);
+  // Byte 123 of the NIfTI-1 header is xyzt_units: 1 metre, 2 millimetre, 3 micrometre.
+  for (const auto& [code, scale] : {std::pair<char, double>{1, 1000}, {3, 0.001}}) {
+    std::string other = mm;
+    other[123] = static_cast<char>((other[123] & ~0x07) | code);
+    write_bytes(dir + "/other.nii", other);
+    const VoxelVolume v = read_volume(dir + "/other.nii");
+    EXPECT_NEAR(v.spacing_xyz()[0], 0.5 * scale, 1e-9 * scale);
+    EXPECT_NEAR(v.spacing_xyz()[2], 0.5 * scale, 1e-9 * scale);
+    EXPECT_NEAR(v.origin[1], 20 * scale, 1e-6 * scale);
+  }
+}
+
+TEST(CtVolume, AThresholdBelowEveryVoxelIsRefusedInsteadOfGivingTheScanBox) {
+  const GeneratedMandible& g = generated(MandibleVariant::kAtrophic);
+  try {
+    surface_from_volume(g.ct, -5000.0);
+    ADD_FAILURE() << "a threshold below every voxel gave a surface";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("every voxel of the volume is at or above the threshold"),
+              std::string::npos)
+        << e.what();
+  }
+  // Voxels without a value (NaN) do not count as background nor as bone.
+  VoxelVolume with_nan = g.ct;
+  with_nan.values[0] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(surface_from_volume(with_nan, -5000.0), InputError);
+  EXPECT_NO_THROW(surface_from_volume(with_nan, g.threshold));
+}
+
+// Two blocks of "bone" (1000) in soft tissue (0): a big one with a closed pocket inside and a
+// small separate one.
+VoxelVolume two_blocks_one_pocket() {
+  VoxelVolume v;
+  v.dims = {30, 16, 16};
+  v.spacing = 1.0;
+  v.values.assign(30 * 16 * 16, 0.0f);
+  auto inside = [](int i, int j, int k, int lo_i, int hi_i, int lo, int hi) {
+    return i >= lo_i && i <= hi_i && j >= lo && j <= hi && k >= lo && k <= hi;
+  };
+  for (int k = 0; k < 16; ++k)
+    for (int j = 0; j < 16; ++j)
+      for (int i = 0; i < 30; ++i) {
+        const bool big = inside(i, j, k, 2, 13, 2, 13) && !inside(i, j, k, 6, 9, 6, 9);
+        const bool small = inside(i, j, k, 20, 25, 5, 10);
+        if (big || small) v.values[(static_cast<std::size_t>(k) * 16 + j) * 30 + i] = 1000.0f;
+      }
+  return v;
+}
+
+TEST(CtVolume, DroppedPiecesAndFilledCavitiesAreReported) {
+  CtExtraction dropped;
+  const TriSurface s = surface_from_volume(two_blocks_one_pocket(), 500.0, &dropped);
+  EXPECT_EQ(dropped.dropped_bodies, 1);
+  EXPECT_EQ(dropped.dropped_cavities, 1);
+  // Iso-surfaces halfway between voxel centres: the big block encloses 12^3, the small 6^3, the
+  // pocket 4^3 mm^3.
+  EXPECT_NEAR(dropped.kept_mm3, enclosed_volume(s), 1e-6 * dropped.kept_mm3);
+  EXPECT_NEAR(dropped.kept_mm3, 12.0 * 12 * 12, 30.0);
+  EXPECT_NEAR(dropped.largest_dropped_body_mm3, 6.0 * 6 * 6, 20.0);
+  EXPECT_NEAR(dropped.largest_dropped_cavity_mm3, 4.0 * 4 * 4, 15.0);
+  CtExtraction none;
+  surface_from_volume(generated(MandibleVariant::kAtrophic).ct, 620.0, &none);
+  EXPECT_EQ(none.dropped_bodies, 0);
+  EXPECT_EQ(none.dropped_cavities, 0);
+}
+
+TEST(Cli, SurfaceFromCtWarnsAboutWhatItDrops) {
+  const std::string dir = test::temp_dir();
+  write_volume(dir + "/blocks.mha", two_blocks_one_pocket());
+  const auto r = test::run_hexbite(
+      {"surface", "from-ct", dir + "/blocks.mha", "--threshold", "500", "-o", dir + "/blocks.stl"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: '" + dir + "/blocks.mha': kept only the largest piece"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("dropped 1 separate piece(s)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("filled 1 enclosed cavity"), std::string::npos) << r.err;
 }
 
 TEST(Cli, GenerateThenSurfaceFromCtReproducesTheVolume) {
@@ -387,6 +568,7 @@ TEST(Cli, GenerateThenSurfaceFromCtReproducesTheVolume) {
   const auto ct = test::run_hexbite(
       {"surface", "from-ct", dir + "/jaw.mha", "--threshold", "620", "-o", dir + "/from_ct.stl"});
   ASSERT_EQ(ct.exit_code, 0) << ct.err;
+  EXPECT_EQ(ct.err.find("warning"), std::string::npos) << ct.err;
   const double v0 = enclosed_volume(read_surface(dir + "/jaw.stl"));
   const double v1 = enclosed_volume(read_surface(dir + "/from_ct.stl"));
   EXPECT_NEAR(v1, v0, 0.01 * v0);
@@ -427,7 +609,13 @@ TEST(Cli, SurfaceFromCtBadInputsExitTwoWithoutOutput) {
   const auto high =
       test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "3000", "-o", out});
   EXPECT_EQ(high.exit_code, 2);
-  EXPECT_NE(high.err.find("nothing in the volume exceeds"), std::string::npos) << high.err;
+  EXPECT_NE(high.err.find("jaw.nii.gz': nothing in the volume exceeds"), std::string::npos) << high.err;
+  const auto low =
+      test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "-3000", "-o", out});
+  EXPECT_EQ(low.exit_code, 2);
+  EXPECT_NE(low.err.find("jaw.nii.gz': every voxel of the volume is at or above the threshold"),
+            std::string::npos)
+      << low.err;
   EXPECT_FALSE(fs::exists(out));
   const auto ok =
       test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "620", "-o", out});

@@ -380,6 +380,27 @@ TEST(RunScenario, PatchSelectingNoFacetIsRefusedAtItsLine) {
   EXPECT_NE(err.find("bad.yaml:10:"), std::string::npos) << err;  // the line of that support
 }
 
+// A probe far from the bone (a typo, another frame) used to be moved silently onto the nearest boundary
+// point, 200 mm away, and reported there with exit 0.
+TEST(RunScenario, ProbeFarFromTheBoneIsRefusedAtItsLine) {
+  const std::string err = expect_refused(kSmall + "probes:\n  - {name: lost, at: [0, 0, -200]}\n",
+                                         "probe 'lost' at (0.00, 0.00, -200.00) lies");
+  EXPECT_NE(err.find("bad.yaml:12:"), std::string::npos) << err;
+  EXPECT_NE(err.find("a probe must be in the bone or within 5 mm of it"), std::string::npos) << err;
+}
+
+// A material region that misses the bone (a wrong sign, another frame) used to change nothing without a
+// word: the run solved with the default material everywhere and exit 0.
+TEST(RunScenario, MaterialRegionHoldingNoHexIsRefusedAtItsLine) {
+  const std::string err = expect_refused(
+      kSmall +
+          "materials:\n  regions:\n    - {name: implant, sphere: {center: [0, 0, -100], radius_mm: 3}, "
+          "E_MPa: 110000}\n",
+      "material region 'implant' holds no hex of the");
+  EXPECT_NE(err.find("bad.yaml:13:"), std::string::npos) << err;
+  EXPECT_NE(err.find("mm outside it: move it into the bone or enlarge it"), std::string::npos) << err;
+}
+
 // Two separate 20 mm cubes (x 0-20 and 40-60) as OBJ text, outward triangles.
 std::string two_cubes_obj() {
   std::string text;
@@ -433,6 +454,33 @@ outputs: {bite_force: false}
   test::write_file(path, held);
   const json j = run_scenario(path, dir);
   EXPECT_LT(j["equilibrium_residual"].get<double>(), 1e-8);
+}
+
+// A CT geometry whose threshold every voxel reaches: the surface would be the box of the scan, which
+// used to be meshed and solved as if it were the bone. Refused at the geometry's line, naming the file.
+TEST(RunScenario, CtThresholdBelowEveryVoxelIsRefusedAtTheGeometry) {
+  const std::string scenario = R"(name: ct_box
+geometry:
+  ct: {file: jaw.mha, threshold: -5000}
+mesh: {target_hexes: 1500, validation_levels: 0}
+muscles:
+  - {name: pull, activation: 1, insertion: [0, 0, 40], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
+supports:
+  - {name: base, at: [0, 0, 0], radius_mm: 5}
+outputs: {bite_force: false}
+)";
+  const std::string path = write_scenario(scenario);
+  const std::string folder = fs::path(path).parent_path().string();
+  const test::CommandResult gen = test::run_hexbite({"-q", "generate", "mandible", "-o", folder + "/jaw.stl",
+                                                     "--voxel", "1.5", "--ct", folder + "/jaw.mha"});
+  ASSERT_EQ(gen.exit_code, 0) << gen.err;
+  const std::string dir = test::temp_dir() + "/out";
+  const test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(path + ":3:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("jaw.mha: every voxel of the volume is at or above the threshold"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir));
 }
 
 TEST(RunScenario, UnknownKeyIsRefused) {
