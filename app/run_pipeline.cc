@@ -71,10 +71,13 @@ Geometry build_geometry(const Scenario& s) {
       // Marching cubes gives a closed surface by construction, but the same checks as for a surface file
       // catch a threshold that produced something that cannot bound a solid.
       const SurfaceReport report = check_surface(g.surface, s.geometry.file);
-      if (!report.usable())
+      if (!report.usable()) {
+        char threshold[32];
+        std::snprintf(threshold, sizeof threshold, "%g", s.geometry.threshold);
         throw InputError(s.geometry.where.str() + ": the surface of " + s.geometry.file + " at threshold " +
-                         std::to_string(s.geometry.threshold) +
-                         " cannot bound a solid: " + report.problems.front() + "; try another threshold");
+                         threshold + " cannot bound a solid: " + report.problems.front() +
+                         "; try another threshold");
+      }
       break;
     }
   }

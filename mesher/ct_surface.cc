@@ -39,6 +39,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A voxel value or threshold as people write it: -2000, 620.5 (std::to_string gives -2000.000000).
+std::string value_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 enum class VolumeFormat { kMetaImage, kNifti };
 
 struct FormatAndExtension {
@@ -362,12 +369,12 @@ TriSurface surface_from_volume(const VoxelVolume& volume, double threshold, CtEx
   const float* lo = &lo_value;
   const float* hi = &hi_value;
   if (!(*hi > threshold))
-    throw InputError("nothing in the volume exceeds the threshold " + std::to_string(threshold) +
-                     " (values range from " + std::to_string(*lo) + " to " + std::to_string(*hi) +
+    throw InputError("nothing in the volume exceeds the threshold " + value_text(threshold) +
+                     " (values range from " + value_text(*lo) + " to " + value_text(*hi) +
                      "); choose a lower threshold");
   if (!(*lo < threshold))
-    throw InputError("every voxel of the volume is at or above the threshold " + std::to_string(threshold) +
-                     " (values range from " + std::to_string(*lo) + " to " + std::to_string(*hi) +
+    throw InputError("every voxel of the volume is at or above the threshold " + value_text(threshold) +
+                     " (values range from " + value_text(*lo) + " to " + value_text(*hi) +
                      "): the surface would be the box of the whole scan, not the bone; choose a higher "
                      "threshold");
   // One voxel of background around the grid closes the iso-surface where the object touches the
@@ -467,7 +474,7 @@ TriSurface surface_from_volume(const VoxelVolume& volume, double threshold, CtEx
     s.triangles.push_back(t);
   }
   if (s.triangles.empty())
-    throw InputError("the iso-surface at threshold " + std::to_string(threshold) + " is empty");
+    throw InputError("the iso-surface at threshold " + value_text(threshold) + " is empty");
 
   // Marching cubes orients all triangles consistently; the sign of the enclosed volume tells
   // whether that orientation points out of the solid.

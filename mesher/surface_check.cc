@@ -118,6 +118,37 @@ std::size_t drop_unreferenced_vertices(TriSurface& s) {
   return dropped;
 }
 
+// Removes triangles that repeat an earlier one with the same orientation (the same three vertices in the
+// same cyclic order), a common artefact of STL exports that makes each of its edges non-manifold; keeps the
+// order of the rest. A copy in the opposite orientation is no duplicate (it is reported as non-manifold or
+// inconsistent). Returns the first removed triangle's index in the input (or -1) through `first`.
+std::size_t drop_duplicate_triangles(TriSurface& s, long* first) {
+  std::vector<std::array<int, 4>> keys;  // the rotation starting at the smallest vertex, and the index
+  keys.reserve(s.triangles.size());
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const auto& tri = s.triangles[t];
+    const int r = tri[0] <= std::min(tri[1], tri[2]) ? 0 : tri[1] <= tri[2] ? 1 : 2;
+    keys.push_back({tri[r], tri[(r + 1) % 3], tri[(r + 2) % 3], static_cast<int>(t)});
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<char> drop(s.triangles.size(), 0);
+  for (std::size_t i = 1; i < keys.size(); ++i)
+    if (keys[i][0] == keys[i - 1][0] && keys[i][1] == keys[i - 1][1] && keys[i][2] == keys[i - 1][2])
+      drop[static_cast<std::size_t>(keys[i][3])] = 1;  // the later one of the sorted pair: a larger index
+  *first = -1;
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    if (drop[t]) {
+      if (*first < 0) *first = static_cast<long>(t);
+      continue;
+    }
+    s.triangles[kept++] = s.triangles[t];
+  }
+  const std::size_t dropped = s.triangles.size() - kept;
+  s.triangles.resize(kept);
+  return dropped;
+}
+
 bool has_repeated_corner(const std::array<int, 3>& t) {
   return t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
 }
@@ -294,6 +325,12 @@ SurfaceReport check_surface(TriSurface& surface, const std::string& file_name) {
   // Merged-away vertices are unreferenced now as well; only the others count as unused.
   if (const std::size_t unused = drop_unreferenced_vertices(s) - merged)
     r.repairs.push_back("removed " + plural(unused, "vertex", "vertices") + " not used by any triangle");
+  long first_duplicate = -1;
+  if (const std::size_t duplicates = drop_duplicate_triangles(s, &first_duplicate))
+    r.repairs.push_back(
+        "removed " + plural(duplicates, "duplicated triangle", "duplicated triangles") +
+        " (the same three vertices in the same order as an earlier one; the first was triangle " +
+        std::to_string(first_duplicate) + " of the file)");
   r.triangles = s.triangles.size();
   r.vertices = s.vertices.size();
   if (s.triangles.empty()) {

@@ -217,6 +217,23 @@ TEST(CliBadInput, NonManifoldEdge) {
                   "1 non-manifold edge (shared by more than two triangles)");
 }
 
+// A triangle repeated with the same orientation (an STL export artefact) is dropped as a safe repair; before,
+// it made its three edges "non-manifold" and the surface unusable. A copy in the opposite orientation is
+// not a duplicate and stays a problem.
+TEST(Cli, DuplicatedTriangleIsRemovedAsARepair) {
+  const std::string out = temp_dir() + "/repaired.stl";
+  const auto r =
+      run_hexbite({"surface", "check", write_case("dup.obj", cube_obj(-1, "f 4 2 1\n")), "-o", out});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(
+      r.out.find("removed 1 duplicated triangle (the same three vertices in the same order as an earlier "
+                 "one; the first was triangle 12 of the file)"),
+      std::string::npos)
+      << r.out;
+  EXPECT_TRUE(fs::exists(out));
+  expect_rejected(write_case("flipped.obj", cube_obj(-1, "f 1 2 4\n")), "3 non-manifold edges");
+}
+
 TEST(CliBadInput, InconsistentOrientation) {
   std::string text = cube_obj();
   text.replace(text.find("f 3 8 4"), 7, "f 3 4 8");

@@ -610,6 +610,8 @@ TEST(Cli, SurfaceFromCtBadInputsExitTwoWithoutOutput) {
       test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "3000", "-o", out});
   EXPECT_EQ(high.exit_code, 2);
   EXPECT_NE(high.err.find("jaw.nii.gz': nothing in the volume exceeds"), std::string::npos) << high.err;
+  // Values as written, not std::to_string's "3000.000000".
+  EXPECT_NE(high.err.find("the threshold 3000 (values range from "), std::string::npos) << high.err;
   const auto low =
       test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "-3000", "-o", out});
   EXPECT_EQ(low.exit_code, 2);
