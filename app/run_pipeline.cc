@@ -22,6 +22,7 @@
 #include "mesher/mandible_sheet_mesher.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
+#include "mesher/union_find.h"
 #include "mesher/units.h"
 #include "solver/mpi_session.h"
 
@@ -304,19 +305,15 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
 // equilibrium failure with displacements of 1e12 mm. InputError naming the body and the supports' lines.
 void require_every_body_held(const Scenario& s, const LevelResult& r) {
   const HexMesh& mesh = r.mesh;
-  std::vector<int> parent(mesh.vertices.size());
-  for (std::size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  UnionFind pieces(mesh.vertices.size());
   for (const auto& hex : mesh.hexes)
-    for (int c = 1; c < 8; ++c) parent[find(hex[c])] = find(hex[0]);
-  std::map<int, int> body_of_root;  // root vertex -> body index, in the order of the first hex
+    for (int c = 1; c < 8; ++c) pieces.unite(hex[0], hex[c]);
+  std::map<std::size_t, int> body_of_root;  // root vertex -> body index, in the order of the first hex
   std::vector<long> hexes;
   std::vector<Vec3> centre_sum;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
-    const auto [it, fresh] = body_of_root.emplace(find(mesh.hexes[h][0]), static_cast<int>(hexes.size()));
+    const auto [it, fresh] =
+        body_of_root.emplace(pieces.find(mesh.hexes[h][0]), static_cast<int>(hexes.size()));
     if (fresh) hexes.push_back(0), centre_sum.push_back({0, 0, 0});
     ++hexes[it->second];
     const Vec3 c = hex_centroid(mesh, static_cast<int>(h));
@@ -328,7 +325,7 @@ void require_every_body_held(const Scenario& s, const LevelResult& r) {
   for (std::size_t i = 0; i < s.supports.size(); ++i)
     for (const auto& face : r.support_patches[i].faces)
       for (int v : face) {
-        std::array<bool, 3>& h = held[body_of_root.at(find(v))];
+        std::array<bool, 3>& h = held[body_of_root.at(pieces.find(v))];
         for (int a = 0; a < 3; ++a) h[a] = h[a] || s.supports[i].spring_N_per_mm3 || s.supports[i].fixed[a];
       }
   for (int b = 0; b < bodies; ++b) {

@@ -17,6 +17,7 @@
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality_kernel.h"
 #include "mesher/surface_projector.h"
+#include "mesher/union_find.h"
 
 namespace hexbite {
 
@@ -109,18 +110,13 @@ double winding_number(const TriSurface& surface, const std::vector<int>& triangl
 Shells find_shells(const TriSurface& surface) {
   Shells sh;
   const std::size_t nt = surface.triangles.size();
-  std::vector<int> parent(surface.vertices.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const auto& tri : surface.triangles) parent[find(tri[1])] = parent[find(tri[2])] = find(tri[0]);
+  UnionFind pieces(surface.vertices.size());
+  for (const auto& tri : surface.triangles) pieces.unite(tri[0], tri[1]), pieces.unite(tri[0], tri[2]);
   std::vector<int> shell_of_root(surface.vertices.size(), -1);
   std::vector<std::vector<int>> members;
   sh.shell_of_triangle.resize(nt);
   for (std::size_t t = 0; t < nt; ++t) {
-    int& shell = shell_of_root[find(surface.triangles[t][0])];
+    int& shell = shell_of_root[pieces.find(surface.triangles[t][0])];
     if (shell < 0) shell = int(members.size()), members.emplace_back();
     members[shell].push_back(int(t));
     sh.shell_of_triangle[t] = shell;
@@ -861,12 +857,7 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
                                                const std::vector<double>& vertex_dist,
                                                const std::vector<double>& centroid_dist, double limit) {
   const std::size_t nt = surface.triangles.size();
-  std::vector<int> parent(surface.vertices.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  UnionFind pieces(surface.vertices.size());
   std::vector<char> far_triangle(nt, 0);
   for (std::size_t t = 0; t < nt; ++t) {
     const auto& tri = surface.triangles[t];
@@ -874,9 +865,8 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
     for (int v : tri) far = far || vertex_dist[v] > limit;
     if (!far) continue;
     far_triangle[t] = 1;
-    const int r0 = find(tri[0]);
-    parent[find(tri[1])] = r0;
-    parent[find(tri[2])] = r0;
+    pieces.unite(tri[0], tri[1]);
+    pieces.unite(tri[0], tri[2]);
   }
   std::vector<int> region(surface.vertices.size(), -1);
   std::vector<UnresolvedPart> parts;
@@ -886,7 +876,7 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
   for (std::size_t t = 0; t < nt; ++t) {
     if (!far_triangle[t]) continue;
     const auto& tri = surface.triangles[t];
-    const int root = find(tri[0]);
+    const std::size_t root = pieces.find(tri[0]);
     if (region[root] < 0) {
       region[root] = int(parts.size());
       parts.push_back({});

@@ -27,6 +27,7 @@
 
 #include "common/error.h"
 #include "mesher/surface_io.h"
+#include "mesher/union_find.h"
 
 namespace hexbite {
 
@@ -60,23 +61,6 @@ std::string problem(std::size_t count, const std::string& what, const std::vecto
   if (count > locations.size()) s += "; and " + std::to_string(count - locations.size()) + " more";
   return s + ". " + advice;
 }
-
-class UnionFind {
- public:
-  explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  std::size_t find(std::size_t i) {
-    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
-    return i;
-  }
-  void unite(std::size_t a, std::size_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<std::size_t> parent_;
-};
 
 // Merges vertices with exactly equal coordinates onto the first of them in file order (what CGAL's
 // merge_duplicate_points_in_polygon_soup does, but keeping the file's vertex order, which makes
