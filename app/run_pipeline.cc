@@ -24,6 +24,7 @@
 #include "mesher/surface_projector.h"
 #include "mesher/union_find.h"
 #include "mesher/units.h"
+#include "mesher/vec3.h"
 #include "solver/mpi_session.h"
 
 namespace hexbite {
@@ -369,9 +370,7 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Pr
     const SurfacePoint foot = mesh_boundary.closest(p);
     // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
     // away is a typo or a point of another frame, and its values would be those of an unrelated place.
-    const double outside = std::sqrt((foot.point[0] - p[0]) * (foot.point[0] - p[0]) +
-                                     (foot.point[1] - p[1]) * (foot.point[1] - p[1]) +
-                                     (foot.point[2] - p[2]) * (foot.point[2] - p[2]));
+    const double outside = vec3::norm(vec3::sub(foot.point, p));
     if (outside > kProbeMaxOutsideMm) {
       char buf[400];
       std::snprintf(
