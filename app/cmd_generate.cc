@@ -2,7 +2,6 @@
 // the CT-like volume it was extracted from.
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -28,31 +27,6 @@ struct GenerateArgs {
   MandibleParameters parameters;
 };
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
-bool has_suffix(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-// Every output is checked before the (short) generation so that a mistake in one of them never
-// leaves the others written.
-void check_output(const std::string& path, const std::vector<std::string>& extensions, const char* what) {
-  const std::string l = lower(path);
-  if (std::none_of(extensions.begin(), extensions.end(),
-                   [&](const std::string& e) { return has_suffix(l, e); })) {
-    std::string list;
-    for (const auto& e : extensions) list += (list.empty() ? "" : ", ") + e;
-    throw InputError("cannot write " + std::string(what) + " '" + path + "': use one of " + list);
-  }
-  const fs::path dir = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
-  if (!fs::is_directory(dir))
-    throw InputError("cannot write '" + path + "': directory '" + dir.string() +
-                     "' does not exist; create it first");
-}
-
 std::string default_landmark_path(const std::string& surface_path) {
   fs::path p(surface_path);
   return (p.parent_path() / (p.stem().string() + ".landmarks.yaml")).string();
@@ -76,9 +50,8 @@ void run_generate(const GenerateArgs& args) {
   params = complete_parameters(params);
   const std::string landmark_path =
       args.landmarks.empty() ? default_landmark_path(args.output) : args.landmarks;
-  check_output(args.output, {".stl", ".obj", ".ply", ".off", ".vtp"}, "surface");
-  check_output(landmark_path, {".yaml", ".yml"}, "landmarks");
-  if (!args.ct.empty()) check_output(args.ct, {".mha", ".mhd", ".nii", ".nii.gz"}, "CT volume");
+  // Every output path was checked while parsing (app/option_checks.h), so a mistake in one of them never
+  // leaves the others written; the default landmark path shares the checked output's folder.
 
   const auto start = std::chrono::steady_clock::now();
   Progress progress("generate mandible");
