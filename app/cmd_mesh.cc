@@ -175,8 +175,7 @@ void run_mesh(const MeshOptions& o) {
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
   const double scale = unit_to_mm(o.units);
   const TriSurface surface = load_closed_surface(o.surface, scale);
-  std::unique_ptr<Landmarks> landmarks;
-  if (!o.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(o.landmarks, scale));
+  const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(o.landmarks, scale, surface);
 
   GridMeshOptions options;
   options.target_hexes = o.target;

@@ -188,11 +188,19 @@ void add_refine_options(CLI::App& cmd, RefineCommandOptions& o) {
       ->needs(at);
 }
 
+std::unique_ptr<Landmarks> load_landmarks_for(const std::string& file, double scale,
+                                              const TriSurface& surface) {
+  if (file.empty()) return nullptr;
+  auto landmarks = std::make_unique<Landmarks>(read_landmarks(file, scale));
+  const std::string warning = landmark_fit_warning(*landmarks, surface, file);
+  if (!warning.empty()) std::cerr << "hexbite: warning: " << warning << ".\n";
+  return landmarks;
+}
+
 void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
   const double scale = unit_to_mm(o.units);
   const TriSurface surface = load_closed_surface(o.surface, scale);
-  std::unique_ptr<Landmarks> landmarks;
-  if (!o.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(o.landmarks, scale));
+  const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(o.landmarks, scale, surface);
   const LocalRefinementOptions refinement = refinement_options(o.refine, landmarks.get(), o.landmarks);
   MandibleQuadReport report;
   QuadSurfaceReport check;
@@ -229,8 +237,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   options.landmark_file = qo.landmarks;
   const double scale = unit_to_mm(qo.units);
   const TriSurface surface = load_closed_surface(qo.surface, scale);
-  std::unique_ptr<Landmarks> landmarks;
-  if (!qo.landmarks.empty()) landmarks = std::make_unique<Landmarks>(read_landmarks(qo.landmarks, scale));
+  const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(qo.landmarks, scale, surface);
   options.refinement = refinement_options(qo.refine, landmarks.get(), qo.landmarks);
   options.fit_volume = o.fit_volume;
   MandibleSheetReport sheet_report;

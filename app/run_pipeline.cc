@@ -88,7 +88,11 @@ Geometry build_geometry(const Scenario& s) {
         implausible_size_warning(largest_extent(g.surface), "add units: m to geometry.surface");
     if (!size_warning.empty()) warn(s.geometry.where.str() + ": " + s.geometry.file + ": " + size_warning);
   }
-  if (!s.landmarks.file.empty()) g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
+  if (!s.landmarks.file.empty()) {
+    g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
+    const std::string fit = landmark_fit_warning(g.landmarks, g.surface, s.landmarks.file);
+    if (!fit.empty()) warn(s.landmarks.where.str() + ": " + fit);
+  }
   return g;
 }
 

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "mesher/surface_projector.h"
 
 namespace hexbite {
 
@@ -157,6 +159,31 @@ void write_landmarks(const std::string& path, const Landmarks& landmarks, const 
     s << "  - {name: " << m.name << ", max_force_N: " << format_number(m.max_force_N)
       << ", insertion: " << format_point(m.insertion) << ", origin: " << format_point(m.origin) << "}\n";
   write_file_atomically(path, s.str());
+}
+
+std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& surface,
+                                 const std::string& file) {
+  if (landmarks.muscles.empty() || surface.triangles.empty()) return {};
+  const SurfaceProjector projector(surface);
+  std::vector<std::pair<double, std::string>> off;  // (distance, muscle)
+  for (const MuscleLine& m : landmarks.muscles) off.emplace_back(projector.distance(m.insertion), m.name);
+  std::sort(off.begin(), off.end(), std::greater<>());
+  const std::size_t n = off.size();
+  const double median = n % 2 ? off[n / 2].first : 0.5 * (off[n / 2 - 1].first + off[n / 2].first);
+  if (median <= kLandmarkFitMedianMm) return {};
+  std::string farthest;
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, n); ++i) {
+    char item[160];
+    std::snprintf(item, sizeof item, "%s%s (%.1f mm)", i ? ", " : "", off[i].second.c_str(), off[i].first);
+    farthest += item;
+  }
+  char text[200];
+  std::snprintf(text, sizeof text, "its %zu muscle insertions lie a median %.1f mm from the surface", n,
+                median);
+  return "landmark file " + file + ": " + text +
+         " (they lie on the bone, within about 1 mm, when the file belongs to it); farthest: " + farthest +
+         ". Placements and patches built from it will be off: check that the file was written for this "
+         "surface, in its frame and units";
 }
 
 }  // namespace hexbite

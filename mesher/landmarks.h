@@ -12,10 +12,10 @@
 namespace hexbite {
 
 struct MuscleLine {
-  std::string name;      // e.g. left_superficial_masseter
+  std::string name;  // e.g. left_superficial_masseter
   double max_force_N = 0;
-  Vec3 insertion{};      // on the bone surface
-  Vec3 origin{};         // on the skull; sets the line of action
+  Vec3 insertion{};  // on the bone surface
+  Vec3 origin{};     // on the skull; sets the line of action
 };
 
 struct Landmarks {
@@ -30,5 +30,15 @@ struct Landmarks {
 Landmarks read_landmarks(const std::string& path, double scale_to_mm = 1.0);
 // Written atomically with a header comment giving the frame; deterministic.
 void write_landmarks(const std::string& path, const Landmarks& landmarks, const std::string& header_comment);
+
+// Whether a landmark file belongs to a surface. Muscle insertions lie on the bone (within about 1 mm; the
+// landmark points may lie inside it, such as TMJ points under the condyle top), so a file written for another
+// bone, frame or unit leaves them off this surface: a mandible's file on a similar mandible in the same frame
+// puts them a median 2-3 mm away, and the template then lands 6-7 mm off. Returns an empty string when the
+// median insertion distance is at most kLandmarkFitMedianMm (or the file has no muscles), else a warning
+// naming the file, the median and the farthest insertions, and what to check.
+constexpr double kLandmarkFitMedianMm = 1.5;
+std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& surface,
+                                 const std::string& file);
 
 }  // namespace hexbite

@@ -316,6 +316,27 @@ TEST(Landmarks, ReadsTheSharedRealJawFile) {
   EXPECT_NEAR(cm.points.at("left_condyle_tmj_point")[2], 796.4, 1e-9);
 }
 
+// A landmark file of another mandible in the same frame was accepted silently, and the quad template placed
+// by it landed 6.4-6.7 mm off the bone. Each file fits its own bone (median insertion distance 0 mm on the
+// built-in mandible, 0.5 mm on the real jaw) and is flagged on the other (2.9 and 3.2 mm).
+TEST(Landmarks, AFileOfAnotherMandibleIsFlaggedAndItsOwnIsNot) {
+  const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
+  const Landmarks jaw_landmarks = read_landmarks(jaw_file);
+  const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
+  const GeneratedMandible& built_in = generated(MandibleVariant::kDentate);
+  EXPECT_EQ(landmark_fit_warning(jaw_landmarks, jaw, jaw_file), "");
+  EXPECT_EQ(landmark_fit_warning(built_in.landmarks, built_in.surface, "m.yaml"), "");
+  const std::string on_jaw = landmark_fit_warning(built_in.landmarks, jaw, "m.yaml");
+  EXPECT_NE(on_jaw.find("landmark file m.yaml: its 18 muscle insertions lie a median 2."), std::string::npos)
+      << on_jaw;
+  EXPECT_NE(on_jaw.find("deep_masseter"), std::string::npos) << on_jaw;
+  const std::string on_built_in = landmark_fit_warning(jaw_landmarks, built_in.surface, jaw_file);
+  EXPECT_NE(on_built_in.find("anterior_temporalis"), std::string::npos) << on_built_in;
+  // A file in cm read as mm is off by far more.
+  const Landmarks cm = read_landmarks(jaw_file, 0.1);
+  EXPECT_NE(landmark_fit_warning(cm, jaw, jaw_file), "");
+}
+
 void expect_landmark_error(const std::string& contents, const std::string& expected_fragment) {
   const std::string path = test::temp_dir() + "/bad.yaml";
   test::write_file(path, contents);

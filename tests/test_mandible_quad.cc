@@ -301,6 +301,15 @@ TEST(MandibleQuadsCli, FromMandibleWritesACheckedQuadSurface) {
   EXPECT_EQ(static_cast<int>(q.quads.size()), j["quads"].get<int>());
   const auto check = test::run_hexbite({"quad", "check", dir + "/q.obj"});
   EXPECT_EQ(check.exit_code, 0) << check.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  // Another mandible's landmark file still places the template, but not silently.
+  const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
+  const auto other = test::run_hexbite(
+      {"quad", "from-mandible", dir + "/m.stl", "--landmarks", jaw_file, "-o", dir + "/q2.obj", "--quiet"});
+  EXPECT_EQ(other.exit_code, 0) << other.err;
+  EXPECT_NE(other.err.find("hexbite: warning: landmark file " + jaw_file + ": its 18 muscle insertions lie"),
+            std::string::npos)
+      << other.err;
 }
 
 TEST(MandibleQuadsCli, BadLandmarkFilesExitWithCode2AndNameTheFile) {
