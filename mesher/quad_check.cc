@@ -249,7 +249,7 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   }
   {
     std::vector<int> first_fan(static_cast<std::size_t>(nv), -1);
-    std::vector<char> bad(static_cast<std::size_t>(nv), 0);
+    std::vector<bool> bad(static_cast<std::size_t>(nv), false);
     for (int q = 0; q < nq; ++q)
       for (int k = 0; k < 4; ++k) {
         const int v = quads[q][k];
@@ -257,9 +257,9 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
         if (first_fan[v] < 0)
           first_fan[v] = f;
         else if (first_fan[v] != f)
-          bad[v] = 1;
+          bad[v] = true;
       }
-    r.non_manifold_vertices = static_cast<int>(std::count(bad.begin(), bad.end(), 1));
+    r.non_manifold_vertices = static_cast<int>(std::count(bad.begin(), bad.end(), true));
   }
   for (int q = 0; q < nq; ++q)
     if (components.find(q) == q) ++r.components;
