@@ -31,6 +31,7 @@
 #include "mesher/hex_quality.h"
 #include "mesher/landmarks.h"
 #include "mesher/surface_check.h"
+#include "mesher/tri_surface.h"
 #include "mesher/units.h"
 #include "postprocess/quality_json.h"
 
@@ -175,6 +176,9 @@ void run_mesh(const MeshOptions& o) {
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
   const double scale = unit_to_mm(o.units);
   const TriSurface surface = load_closed_surface(o.surface, scale);
+  // The mesh would come out fine, but in the wrong unit every later number (and the solver's) is off by 1000.
+  const std::string size_warning = implausible_size_warning(largest_extent(surface), "give --units m");
+  if (!size_warning.empty()) std::cerr << "hexbite: warning: '" << o.surface << "': " << size_warning << '\n';
   const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(o.landmarks, scale, surface);
 
   GridMeshOptions options;

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -126,7 +127,8 @@ void add_surface_clean_command(CLI::App& surface) {
       ->capture_default_str();
   cmd->add_option("--target-triangles", options->clean.target_triangles,
                   "Reduce the surface to at most this many triangles (0: no reduction)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(count_in_range(0, std::numeric_limits<int>::max()));
   cmd->add_option("--max-deviation", options->clean.max_deviation_mm,
                   "Bound on the Hausdorff distance between the input and the result, in mm")
       ->capture_default_str();

@@ -770,12 +770,30 @@ void throw_on_collinear_corners(const QuadSurface& surface) {
     throw InputError(first + (flat > 1 ? " (" + std::to_string(flat) + " such quad corners in all)" : ""));
 }
 
+// The surface with every quad's corners reversed when the quads face inward (the volume they enclose, each
+// split along its 0-2 diagonal, is negative): the same solid, whose hexes would otherwise all be inverted.
+QuadSurface facing_outward(const QuadSurface& surface) {
+  QuadSurface out = surface;
+  if (surface.vertices.empty()) return out;
+  const Vec3& o = surface.vertices[0];
+  double volume6 = 0;
+  for (const Quad& q : surface.quads)
+    for (int k : {1, 2})
+      volume6 += vec3::dot(
+          vec3::sub(surface.vertices[q[0]], o),
+          vec3::cross(vec3::sub(surface.vertices[q[k]], o), vec3::sub(surface.vertices[q[k + 1]], o)));
+  if (volume6 < 0)
+    for (Quad& q : out.quads) std::reverse(q.begin(), q.end());
+  return out;
+}
+
 }  // namespace
 
-HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
+HexMesh mesh_by_cycle_elimination(const QuadSurface& input, const SheetMeshOptions& options,
                                   SheetMeshReport* report) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  const QuadSurface surface = facing_outward(input);
   SheetMeshReport counts;
   HexMesh mesh = sheet_complex(surface, options, 0, options.decomposition.max_depth, counts);
   if (options.optimize) throw_on_collinear_corners(surface);

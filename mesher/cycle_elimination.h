@@ -178,7 +178,8 @@ struct SheetMeshReport {
 
 // Steps 1 to 3, with the look-ahead order and then decomposition where the elimination is stuck. The counts
 // of eliminations and sheets add up over the parts of a decomposition. With options.optimize, InputError when
-// a quad has three collinear corners (no valid hex mesh has that boundary).
+// a quad has three collinear corners (no valid hex mesh has that boundary). Quads that all face inward (a
+// negative enclosed volume) are meshed with their corners reversed: the same solid, no inverted hexes.
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
                                   SheetMeshReport* report = nullptr);
 

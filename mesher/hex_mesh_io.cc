@@ -63,16 +63,30 @@ void check_readable(const std::string& path, const char* what) {
 
 // Checks vertex coordinates and hex indices of a mesh just read; `where` names the file.
 void check_mesh(const HexMesh& mesh, const std::string& where) {
+  if (mesh.hexes.empty())
+    throw InputError(where + " holds no hexahedra (" + std::to_string(mesh.vertices.size()) +
+                     " points and no volume cells): give a hex mesh");
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
     for (double c : mesh.vertices[v])
       if (!std::isfinite(c))
         throw InputError(where + ": vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
   const long n = static_cast<long>(mesh.vertices.size());
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-    for (int v : mesh.hexes[h])
-      if (v < 0 || v >= n)
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    const std::array<int, 8>& hex = mesh.hexes[h];
+    for (int k = 0; k < 8; ++k) {
+      if (hex[k] < 0 || hex[k] >= n)
         throw InputError(where + ": hexahedron " + std::to_string(h) + " refers to vertex " +
-                         std::to_string(v) + ", but there are only " + std::to_string(n) + " vertices");
+                         std::to_string(hex[k]) + ", but there are only " + std::to_string(n) + " vertices");
+      // A collapsed (degenerate) hex has no volume at that corner; its measures would call it inverted.
+      for (int j = 0; j < k; ++j)
+        if (hex[j] == hex[k])
+          throw InputError(where + ": hexahedron " + std::to_string(h) + " lists vertex " +
+                           std::to_string(hex[k]) + " twice (corners " + std::to_string(j) + " and " +
+                           std::to_string(k) +
+                           "); a hexahedron needs 8 distinct vertices: collapsed hexes are not supported, "
+                           "fix the connectivity where the mesh was made");
+    }
+  }
 }
 
 void check_arrays(const std::vector<MeshArray>& arrays, std::size_t count, const char* kind,
@@ -181,7 +195,7 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
         ": not a VTK XML unstructured grid (.vtu) file; expected a <VTKFile type=\"UnstructuredGrid\"> "
         "document");
   reader->SetFileName(path.c_str());
-  reader->Update();
+  update_xml_reader(reader, path);
   vtkUnstructuredGrid* grid = reader->GetOutput();
   // Warnings (for example about an unknown array type) do not make a file unreadable; errors do.
   if (!capture.errors().empty() || grid == nullptr)
@@ -341,7 +355,8 @@ class MshReader {
   bool next_line(std::string& line) {
     if (!std::getline(in_, line)) return false;
     ++line_no_;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    // Trailing blanks and a '\r' as Gmsh itself ignores them: "$Nodes " is still the $Nodes section.
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
     return true;
   }
   std::istringstream numbers() {
@@ -465,10 +480,13 @@ HexMesh read_msh(const std::string& path) {
           int dim = 0, entity = 0, parametric = 0;
           long in_block = 0;
           r.read(bs, dim, entity, parametric, in_block);
-          std::vector<long> tags(in_block);
-          for (long& t : tags) {
+          if (in_block < 0 || in_block > count)
+            r.fail("a block of " + std::to_string(in_block) + " nodes, but the section announces " +
+                   std::to_string(count) + " nodes in all");
+          std::vector<long> tags;  // grows as tags are read: a cut-off file then fails on its lines
+          for (long i = 0; i < in_block; ++i) {
             auto ts = r.numbers();
-            r.read(ts, t);
+            r.read(ts, tags.emplace_back());
           }
           for (long t : tags) {
             auto cs = r.numbers();

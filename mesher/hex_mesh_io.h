@@ -4,8 +4,9 @@
 // Input/output: a HexMesh in VTK node order plus optional named per-cell and per-point arrays. Writers are
 // atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
 // hexahedra and throw InputError naming the file and what is wrong: missing, unreadable, not a mesh of that
-// format, a cell that is not a hexahedron (with its index and type), a NaN or infinite coordinate, a vertex
-// index out of range. Orientation is not checked here: that is the quality module's job (inverted hexes).
+// format, a cell that is not a hexahedron (with its index and type), no hexahedron at all, a NaN or infinite
+// coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes). Orientation
+// is not checked here: that is the quality module's job (inverted hexes).
 // Cost: linear in the mesh size.
 #pragma once
 

@@ -108,6 +108,8 @@ std::optional<Vec3> Landmarks::find(const std::string& name) const {
 
 Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
   if (!std::filesystem::exists(path)) throw InputError("landmark file '" + path + "' does not exist");
+  if (std::filesystem::is_directory(path))
+    throw InputError("landmark file '" + path + "' is a folder: give the .yaml file in it");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -142,8 +144,8 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
       }
     }
   } catch (const YAML::Exception& e) {
-    // Keys that are not scalars (e.g. a list used as a key) end up here.
-    fail(path, e.mark, e.msg);
+    // Keys that are not scalars (e.g. a list used as a key) end up here; yaml-cpp says only "bad conversion".
+    fail(path, e.mark, "expected a name (a plain word) as the key, not a list or map (YAML: " + e.msg + ")");
   }
   return out;
 }

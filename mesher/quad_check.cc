@@ -294,9 +294,22 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
         "odd number of quads (" + std::to_string(nq) +
         "): a hex mesh of a ball needs an even number of boundary quads (Thurston, Mitchell); "
         "refine or remesh the quad surface");
-  if (!r.closed)
-    r.problems.push_back("not closed: " + count(r.open_edges, "open edge", "open edges") +
-                         " (edges in only one quad); close the holes");
+  if (!r.closed) {
+    // Quads exported each with its own corners (unwelded) leave every edge open without a visible hole.
+    std::vector<Vec3> positions;
+    for (int v = 0; v < nv; ++v)
+      if (used[v]) positions.push_back(surface.vertices[v]);
+    std::sort(positions.begin(), positions.end());
+    int coincident = 0;
+    for (std::size_t i = 1; i < positions.size(); ++i)
+      if (positions[i] == positions[i - 1]) ++coincident;
+    r.problems.push_back(
+        "not closed: " + count(r.open_edges, "open edge", "open edges") + " (edges in only one quad); " +
+        (coincident > 0 ? count(coincident, "vertex lies", "vertices lie") +
+                              " exactly on another one: the quads are not welded, merge coincident vertices "
+                              "where the surface was made"
+                        : std::string("close the holes")));
+  }
   if (!r.manifold)
     r.problems.push_back("not manifold: " + count(r.non_manifold_edges, "edge", "edges") +
                          " in more than two quads, " +

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -109,6 +110,9 @@ QuadSurface read_obj(const std::string& path) {
         if (resolved < 0)
           throw InputError(quoted(path) + " " + where + ": face index " + std::to_string(index) +
                            " refers to a vertex before the first one");
+        if (resolved > std::numeric_limits<int>::max())
+          throw InputError(quoted(path) + " " + where + ": face index " + std::to_string(index) +
+                           " is beyond the supported 2^31 vertices");
         q[k] = static_cast<int>(resolved);
       }
       s.quads.push_back(q);
@@ -177,7 +181,7 @@ QuadSurface read_vtp(const std::string& path) {
   if (!reader->CanReadFile(path.c_str()))
     throw InputError(quoted(path) + " is not a VTK XML polydata (.vtp) file");
   reader->SetFileName(path.c_str());
-  reader->Update();
+  update_xml_reader(reader, path);
   if (reader->GetErrorCode() != 0 || !capture.errors().empty())
     throw InputError(quoted(path) + " could not be read as VTK XML polydata (truncated or corrupt file" +
                      capture.reason() + ")");

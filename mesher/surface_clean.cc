@@ -372,7 +372,10 @@ class Cleaner {
             if (plan.flip || v != plan.kept) continue;
           }
           const Point q = CGAL::barycenter(t[0], double(a) / steps, t[1], double(b) / steps, t[2]);
-          if (!tree_.do_intersect(Plain::Sphere_3(Plain::Point_3(q.x(), q.y(), q.z()), bound2_)))
+          const Plain::Point_3 p(q.x(), q.y(), q.z());
+          // CGAL tests the sphere's surface, not the ball: input lying wholly inside the ball (a bound
+          // larger than the solid) misses it, so then the distance decides.
+          if (!tree_.do_intersect(Plain::Sphere_3(p, bound2_)) && tree_.squared_distance(p) > bound2_)
             return false;
         }
       }

@@ -709,7 +709,7 @@ TriSurface read_vtp(const std::string& path) {
         " is not a VTK XML PolyData file: it must be XML with <VTKFile type=\"PolyData\">; export "
         "it again");
   reader->SetFileName(path.c_str());
-  reader->Update();
+  update_xml_reader(reader, path);
   vtkPolyData* data = reader->GetOutput();
   // Warnings (for example about an unknown array type) do not make a file unreadable; errors do.
   if (!capture.errors().empty() || !data)

@@ -1,16 +1,48 @@
 #include "mesher/vtk_messages.h"
 
+#include <vtkDataArraySelection.h>
 #include <vtkLogger.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkOutputWindow.h>
 #include <vtkSmartPointer.h>
+#include <vtkXMLDataElement.h>
+#include <vtkXMLDataParser.h>
+#include <vtkXMLReader.h>
 
 #include <algorithm>
+#include <cstring>
+#include <new>
+
+#include "common/error.h"
 
 namespace hexbite {
 
 namespace {
+
+// Disables, in the reader's selections, the string arrays of every <PointData> and <CellData> below e.
+void disable_string_arrays(vtkXMLDataElement* e, vtkXMLReader* reader) {
+  for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
+    vtkXMLDataElement* child = e->GetNestedElement(i);
+    const char* name = child->GetName();
+    vtkDataArraySelection* selection =
+        name == nullptr                       ? nullptr
+        : std::strcmp(name, "PointData") == 0 ? reader->GetPointDataArraySelection()
+        : std::strcmp(name, "CellData") == 0  ? reader->GetCellDataArraySelection()
+                                              : nullptr;
+    if (selection == nullptr) {
+      disable_string_arrays(child, reader);
+      continue;
+    }
+    for (int k = 0; k < child->GetNumberOfNestedElements(); ++k) {
+      vtkXMLDataElement* array = child->GetNestedElement(k);
+      const char* type = array->GetAttribute("type");
+      const char* array_name = array->GetAttribute("Name");
+      if (type != nullptr && array_name != nullptr && std::strcmp(type, "String") == 0)
+        selection->DisableArray(array_name);
+    }
+  }
+}
 
 // VTK's text is "ERROR: In file.cxx, line N\nvtkClass (0x...): explanation\n\n"; keeps the explanation.
 void append_explanation(std::string& list, const char* text) {
@@ -20,7 +52,11 @@ void append_explanation(std::string& list, const char* text) {
     t = t.substr(std::min(t.size(), t.find('\n') + 1));
   if (const std::size_t object = t.find("): "); object != std::string::npos) t = t.substr(object + 3);
   t = t.substr(0, t.find('\n'));
-  if (t.empty() || t.find("returned failure for request") != std::string::npos) return;
+  // Follow-ups of an error already captured: the pipeline's failed request, and the piece request of an
+  // Update() after a failed UpdateInformation() (update_xml_reader()).
+  if (t.empty() || t.find("returned failure for request") != std::string::npos ||
+      t.find("No update piece number has been set") != std::string::npos)
+    return;
   if (!list.empty()) list += "; ";
   list += t;
 }
@@ -63,6 +99,21 @@ const std::string& VtkMessageCapture::errors() const {
 }
 std::string VtkMessageCapture::reason() const {
   return errors().empty() ? std::string() : " (VTK: " + errors() + ")";
+}
+
+void update_xml_reader(vtkXMLReader* reader, const std::string& file) {
+  try {
+    reader->UpdateInformation();
+    vtkXMLDataParser* parser = reader->GetXMLParser();
+    if (vtkXMLDataElement* root = parser != nullptr ? parser->GetRootElement() : nullptr)
+      disable_string_arrays(root, reader);
+    reader->Update();
+  } catch (const std::bad_alloc&) {
+    // VTK allocates what the header announces before it reads the data.
+    throw RunError("cannot read '" + file +
+                   "': the points and cells it announces do not fit in memory; unless the data is that big, "
+                   "the file is damaged (check the counts in its <Piece> element)");
+  }
 }
 
 }  // namespace hexbite

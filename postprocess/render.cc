@@ -157,7 +157,7 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
     VtkMessageCapture capture;
     if (reader->CanReadFile(vtu_path.c_str()) != 0) {
       reader->SetFileName(vtu_path.c_str());
-      reader->Update();
+      update_xml_reader(reader, vtu_path);
       grid = reader->GetOutput();
     }
     if (!capture.errors().empty() || grid == nullptr || grid->GetNumberOfCells() == 0)

@@ -150,6 +150,13 @@ TEST(Cli, SurfaceInMetresWithoutUnitsIsWarnedAbout) {
   // The unit cube of the other tests is small but plausible: no warning.
   r = run_hexbite({"surface", "check", write_case("cube.obj", cube_obj())});
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  // The grid mesher meshes it just as well (the mesh is fine, in the wrong unit), so it warns too.
+  const std::string mesh = temp_dir() + "/metres.vtu";
+  r = run_hexbite({"mesh", path, "--method", "grid", "--target-hexes", "8", "-o", mesh});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: '" + path + "': the surface is only 0.02 mm across"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST(Cli, RepairedSurfaceIsWrittenInMillimetres) {

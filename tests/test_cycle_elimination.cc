@@ -1,6 +1,7 @@
 // Cycle elimination: the elimination scheme, the hex complex built from it and the embedded mesh.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -49,6 +50,20 @@ TEST(CycleElimination, CubeIsOneHex) {
   ASSERT_EQ(mesh.hexes.size(), 1u);
   EXPECT_EQ(summarize_quality(mesh).inverted, 0);
   expect_boundary_equals_input(mesh, s);
+}
+
+// Quads that all face inward bound the same solid: before, `quad check` called such a surface usable and
+// `mesh --method sheets` then failed (exit 1) with every hex inverted.
+TEST(CycleElimination, InwardQuadsAreMeshedAsTheSameSolid) {
+  for (const std::array<int, 3> dims : {std::array<int, 3>{1, 1, 1}, {3, 2, 2}}) {
+    QuadSurface s = test::block_surface(dims[0], dims[1], dims[2]);
+    for (auto& q : s.quads) std::reverse(q.begin(), q.end());
+    SheetMeshReport report;
+    mesh_by_cycle_elimination(s, {}, &report);
+    EXPECT_EQ(report.hexes, dims[0] * dims[1] * dims[2]);
+    EXPECT_EQ(report.quality.inverted, 0);
+    EXPECT_GT(report.quality.scaled_jacobian.min, 0.999);
+  }
 }
 
 // A single elimination removes exactly one chord, so a perfect scheme of single steps has chords - 3 steps.

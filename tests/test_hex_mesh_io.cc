@@ -16,8 +16,8 @@
 #include <sstream>
 
 #include "common/error.h"
-#include "mesher/hex_block.h"
 #include "mesher/grid_mesher.h"
+#include "mesher/hex_block.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
@@ -163,6 +163,70 @@ TEST(HexMeshIo, VtuReaderErrors) {
   EXPECT_NE(msg.find("damaged or truncated"), std::string::npos) << msg;
 }
 
+// Before, a file without hexahedra read as an empty mesh (quality printed n/a, refine wrote an empty mesh,
+// exit 0), a hex listing a vertex twice was measured as "inverted", and an oversized Gmsh node block ended
+// in std::bad_alloc (exit 1, neither file nor line named).
+TEST(HexMeshIo, ReadersRejectMeshesWithoutHexesOrWithCollapsedHexes) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/none.vtu", ascii_vtu(0, "", "", "", kCubePoints, 8));
+  std::string msg = input_error_of([&] { read_vtu(dir + "/none.vtu"); });
+  EXPECT_NE(msg.find("none.vtu' holds no hexahedra (8 points"), std::string::npos) << msg;
+
+  write_file(dir + "/collapsed.vtu", ascii_vtu(1, "12", "0 1 2 3 4 5 6 6", "8", kCubePoints, 8));
+  msg = input_error_of([&] { read_vtu(dir + "/collapsed.vtu"); });
+  EXPECT_NE(msg.find("hexahedron 0 lists vertex 6 twice (corners 6 and 7)"), std::string::npos) << msg;
+
+  const std::string header =
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+      "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n$Elements\n1\n";
+  write_file(dir + "/quads.msh", header + "1 3 2 0 1 1 2 3 4\n$EndElements\n");
+  msg = input_error_of([&] { read_msh(dir + "/quads.msh"); });
+  EXPECT_NE(msg.find("quads.msh' holds no hexahedra"), std::string::npos) << msg;
+  write_file(dir + "/collapsed.msh", header + "1 5 2 0 1 1 2 3 4 5 6 6 8\n$EndElements\n");
+  msg = input_error_of([&] { read_msh(dir + "/collapsed.msh"); });
+  EXPECT_NE(msg.find("hexahedron 0 lists vertex 5 twice"), std::string::npos) << msg;
+
+  for (const char* count : {"1000000000000000", "-5"}) {
+    write_file(dir + "/block.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n3 1 0 " +
+                                       std::string(count) + "\n1\n0 0 0\n$EndNodes\n");
+    msg = input_error_of([&] { read_msh(dir + "/block.msh"); });
+    EXPECT_NE(msg.find("line 6: a block of " + std::string(count) + " nodes"), std::string::npos) << msg;
+  }
+}
+
+// A string array with fewer values than points crashed VTK's reader (segmentation fault). No command uses
+// string arrays, so it is not read; the numeric array beside it is.
+TEST(HexMeshIo, ShortStringArrayIsSkippedNotACrash) {
+  const std::string dir = temp_dir();
+  std::string labelled = ascii_vtu(1, "12", "0 1 2 3 4 5 6 7", "8", kCubePoints, 8);
+  labelled.insert(labelled.find("<Points>"),
+                  "<PointData><DataArray type=\"String\" Name=\"label\" format=\"ascii\">97 0</DataArray>"
+                  "</PointData><CellData><DataArray type=\"Float64\" Name=\"E\" format=\"ascii\">17000"
+                  "</DataArray></CellData>");
+  write_file(dir + "/labelled.vtu", labelled);
+  std::vector<MeshArray> cell_arrays, point_arrays;
+  EXPECT_EQ(read_vtu(dir + "/labelled.vtu", &cell_arrays, &point_arrays).hexes.size(), 1u);
+  ASSERT_EQ(cell_arrays.size(), 1u);
+  EXPECT_EQ(cell_arrays[0].name, "E");
+  EXPECT_TRUE(point_arrays.empty());
+}
+
+// A damaged point count in the header made VTK allocate petabytes: "failed: std::bad_alloc", no file named.
+TEST(HexMeshIo, ImpossiblePointCountNamesTheFile) {
+  const std::string dir = temp_dir();
+  std::string vtu = ascii_vtu(1, "12", "0 1 2 3 4 5 6 7", "8", kCubePoints, 8);
+  vtu.replace(vtu.find("NumberOfPoints=\"8\""), 18, "NumberOfPoints=\"1000000000000000\"");
+  write_file(dir + "/huge.vtu", vtu);
+  try {
+    read_vtu(dir + "/huge.vtu");
+    ADD_FAILURE() << "no error";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.vtu': the points and cells it announces do not fit in memory"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // Parses the *NODE, *ELEMENT and set blocks of an .inp file written by write_inp.
 struct ParsedInp {
   std::vector<Vec3> nodes;
@@ -266,6 +330,12 @@ TEST(HexMeshIo, MshVersion22WithLowerDimensionalElements) {
              "17\n$EndElements\n");
   const HexMesh m = read_msh(dir + "/v22.msh");
   ASSERT_EQ(m.hexes.size(), 1u);
+  // Trailing blanks after a section name, which Gmsh accepts, hid the section ("$Elements before $Nodes").
+  std::string blanks = read_file(dir + "/v22.msh");
+  blanks.replace(blanks.find("$Nodes\n"), 7, "$Nodes \r\n");
+  blanks.replace(blanks.find("$EndElements\n"), 13, "$EndElements\t\n");
+  write_file(dir + "/blanks.msh", blanks);
+  EXPECT_EQ(read_msh(dir + "/blanks.msh").hexes, m.hexes);
   EXPECT_EQ(m.hexes[0], (std::array<int, 8>{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_EQ(hex_quality(m.vertices.data()).scaled_jacobian, 1.0);
 

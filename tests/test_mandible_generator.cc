@@ -360,7 +360,19 @@ TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n", ":3: unknown section 'muscle'");
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  a: [1, 2, 4]\n", "given twice");
   expect_landmark_error("", "is empty");
+  // yaml-cpp alone says "bad conversion" for a list used as a name.
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  ? [x, y]\n  : [1, 2, 3]\n",
+                        ":3: expected a name (a plain word) as the key");
   EXPECT_THROW(read_landmarks(test::temp_dir() + "/missing.yaml"), InputError);
+  // A folder was read as a stream and failed with a std::ios exception (exit 1, no file named).
+  const std::string folder = test::temp_dir() + "/landmarks.yaml";
+  std::filesystem::create_directory(folder);
+  try {
+    read_landmarks(folder);
+    ADD_FAILURE() << "no error for a folder";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'" + folder + "' is a folder"), std::string::npos) << e.what();
+  }
 }
 
 // Every option within its range, but together a short, wide ramus at the largest gonial angle made a bone

@@ -203,6 +203,22 @@ TEST(SurfaceClean, UnreachableTargetIsExplained) {
   EXPECT_NE(report.target_note.find("stopped at"), std::string::npos);
 }
 
+// The deviation bound was tested with CGAL's sphere test, which is one of the sphere's surface: with a
+// bound wider than the solid every input triangle lay inside the ball, so every contraction was refused
+// (0 operations, "no further contraction keeps the deviation within 100 mm"), while 20 mm reduced it.
+TEST(SurfaceClean, BoundWiderThanTheSolidStillReduces) {
+  const TriSurface sphere = uv_sphere(10.0, 12, 24);
+  CleanOptions options;
+  options.target_triangles = 100;
+  options.max_deviation_mm = 100.0;
+  CleanReport report;
+  TriSurface cleaned = clean_surface(sphere, options, &report);
+  EXPECT_LT(cleaned.triangles.size(), sphere.triangles.size() / 2);
+  EXPECT_LE(report.hausdorff_mm, options.max_deviation_mm);
+  // Coarser (the volume is not kept within the usual 0.5 %: the bound allows far more), but still a solid.
+  EXPECT_TRUE(check_surface(cleaned, "cleaned").usable());
+}
+
 TEST(SurfaceClean, PoleNeedlesOfASphereAreRemoved) {
   // 90 segments: the pole triangles have 4-degree apex angles, and the next band is made of needles.
   const TriSurface sphere = uv_sphere(20.0, 40, 90);
@@ -328,6 +344,9 @@ TEST(SurfaceCleanCli, BadOptionsExitTwo) {
   expect_refused({"--max-deviation", "0"}, jaw, "--max-deviation");
   expect_refused({"--max-deviation", "-0.5"}, jaw, "--max-deviation");
   expect_refused({"--target-triangles", "2"}, jaw, "--target-triangles");
+  // -1 used to wrap around to 18446744073709551615 and was accepted as "no reduction" (exit 0).
+  expect_refused({"--target-triangles", "-1"}, jaw, "--target-triangles: -1 is out of range");
+  expect_refused({"--target-triangles", "2.5"}, jaw, "not a whole number");
   expect_refused({"--units", "inch"}, jaw, "inch");
 }
 
