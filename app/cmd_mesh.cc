@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_inputs.h"
 #include "app/mesh_sheets.h"
 #include "app/mesh_sheets_surface.h"
 #include "app/option_checks.h"
@@ -29,10 +30,7 @@
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
-#include "mesher/landmarks.h"
-#include "mesher/surface_check.h"
 #include "mesher/tri_surface.h"
-#include "mesher/units.h"
 #include "postprocess/quality_json.h"
 
 namespace hexbite {
@@ -174,12 +172,7 @@ void run_mesh(const MeshOptions& o) {
   if (o.method == "sheets")
     return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
-  const double scale = unit_to_mm(o.units);
-  const TriSurface surface = load_closed_surface(o.surface, scale);
-  // The mesh would come out fine, but in the wrong unit every later number (and the solver's) is off by 1000.
-  const std::string size_warning = implausible_size_warning(largest_extent(surface), "give --units m");
-  if (!size_warning.empty()) std::cerr << "hexbite: warning: '" << o.surface << "': " << size_warning << '\n';
-  const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(o.landmarks, scale, surface);
+  const auto [surface, landmarks] = load_mesh_inputs(o.surface, o.units, o.landmarks);
 
   GridMeshOptions options;
   options.target_hexes = o.target;

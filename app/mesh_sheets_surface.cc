@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/mesh_inputs.h"
 #include "app/mesh_sheets.h"
 #include "common/error.h"
 #include "common/progress.h"
@@ -15,13 +16,10 @@
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
-#include "mesher/landmarks.h"
 #include "mesher/mandible_sheet_mesher.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 #include "mesher/quad_surface_placement.h"
-#include "mesher/surface_check.h"
-#include "mesher/units.h"
 #include "postprocess/quality_json.h"
 
 namespace hexbite {
@@ -188,19 +186,8 @@ void add_refine_options(CLI::App& cmd, RefineCommandOptions& o) {
       ->needs(at);
 }
 
-std::unique_ptr<Landmarks> load_landmarks_for(const std::string& file, double scale,
-                                              const TriSurface& surface) {
-  if (file.empty()) return nullptr;
-  auto landmarks = std::make_unique<Landmarks>(read_landmarks(file, scale));
-  const std::string warning = landmark_fit_warning(*landmarks, surface, file);
-  if (!warning.empty()) std::cerr << "hexbite: warning: " << warning << ".\n";
-  return landmarks;
-}
-
 void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
-  const double scale = unit_to_mm(o.units);
-  const TriSurface surface = load_closed_surface(o.surface, scale);
-  const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(o.landmarks, scale, surface);
+  const auto [surface, landmarks] = load_mesh_inputs(o.surface, o.units, o.landmarks);
   const LocalRefinementOptions refinement = refinement_options(o.refine, landmarks.get(), o.landmarks);
   MandibleQuadReport report;
   QuadSurfaceReport check;
@@ -235,9 +222,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   options.order = parse_elimination_order(o.order);
   options.surface_name = qo.surface;
   options.landmark_file = qo.landmarks;
-  const double scale = unit_to_mm(qo.units);
-  const TriSurface surface = load_closed_surface(qo.surface, scale);
-  const std::unique_ptr<Landmarks> landmarks = load_landmarks_for(qo.landmarks, scale, surface);
+  const auto [surface, landmarks] = load_mesh_inputs(qo.surface, qo.units, qo.landmarks);
   options.refinement = refinement_options(qo.refine, landmarks.get(), qo.landmarks);
   options.fit_volume = o.fit_volume;
   MandibleSheetReport sheet_report;

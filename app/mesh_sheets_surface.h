@@ -5,7 +5,6 @@
 // reports (text or JSON) and writes the result. cmd_quad.cc and cmd_mesh.cc only forward their options here.
 #pragma once
 
-#include <memory>
 #include <string>
 
 #include "mesher/landmarks.h"
@@ -37,11 +36,6 @@ struct MandibleQuadCommandOptions {
   bool json = false;
   RefineCommandOptions refine;
 };
-
-// The optional --landmarks file of a command that meshes `surface` (mm after `scale`): nullptr when `file` is
-// empty; a warning on standard error when the file does not fit the surface (landmark_fit_warning()).
-std::unique_ptr<Landmarks> load_landmarks_for(const std::string& file, double scale,
-                                              const TriSurface& surface);
 
 // quad from-mandible: builds, checks (mesher/quad_check.h) and writes the quad surface atomically; prints
 // the report (text or JSON). InputError for bad input (nothing written), RunError when the quad surface

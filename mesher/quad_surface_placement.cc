@@ -947,6 +947,17 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   if (options.target_quads < 24 || options.target_quads > 200000)
     throw InputError("--target-quads " + std::to_string(options.target_quads) +
                      " is out of range: give a number from 24 to 200,000");
+  // The template is an adult mandible about 100 mm across and its tolerances are in mm: a bone read in the
+  // wrong unit would be warped to a tenth of a millimetre or a metre, and its relaxation can then run for
+  // minutes. (The grid method meshes any size.)
+  if (const double extent = largest_extent(surface); extent < 30.0 || extent > 300.0) {
+    char size[64];
+    std::snprintf(size, sizeof size, "%.4g mm", extent);
+    throw InputError(std::string("the surface is ") + size +
+                     " across (the largest side of its bounding box), but the mandible template places on "
+                     "mandibles 30 to 300 mm across: check the unit (--units m or cm, or units: in a "
+                     "scenario), or use --method grid");
+  }
   MandibleQuadReport report;
   Progress progress("quad surface");
   const MandibleQuadTemplate tmpl = mandible_quad_template();

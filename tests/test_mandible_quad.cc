@@ -284,6 +284,27 @@ TEST(MandibleQuads, NonMandibleSurfaceIsRejected) {
   }
 }
 
+// The real jaw read in metres as millimetres (0.12 mm across) was placed and relaxed for minutes by `mesh
+// --method sheets`; in micrometres (118 m) it would be as wrong. Both are refused at once, naming the size.
+TEST(MandibleQuads, ASurfaceOfNoMandibleSizeIsRefusedBeforePlacement) {
+  const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
+  for (const double scale : {1e-3, 1e3}) {
+    TriSurface scaled = jaw;
+    for (Vec3& v : scaled.vertices)
+      for (double& x : v) x *= scale;
+    try {
+      quad_surface_from_mandible(scaled, nullptr, "", {});
+      FAIL() << "no error at scale " << scale;
+    } catch (const InputError& e) {
+      EXPECT_NE(
+          std::string(e.what()).find(scale < 1 ? "the surface is 0.1177 mm across" : "1.177e+05 mm across"),
+          std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("check the unit"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(MandibleQuadsCli, FromMandibleWritesACheckedQuadSurface) {
   const std::string dir = test::temp_dir();
   ASSERT_EQ(test::run_hexbite({"generate", "mandible", "-o", dir + "/m.stl", "--landmarks", dir + "/m.yaml"})

@@ -1,0 +1,26 @@
+// The inputs of the commands that mesh a triangulated bone (`mesh SURFACE --method grid|sheets`, `quad
+// from-mandible`): the SURFACE, closed and in millimetres, and the optional --landmarks file in the same
+// unit. Each gets a warning on standard error when it does not fit: a size no mandible has (a file in
+// metres read as millimetres), or a landmark file written for another bone, frame or unit
+// (landmark_fit_warning()). Errors (unreadable, open or non-manifold surfaces, malformed landmark files)
+// are InputErrors from the loaders.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "mesher/landmarks.h"
+#include "mesher/tri_surface.h"
+
+namespace hexbite {
+
+struct MeshInputs {
+  TriSurface surface;
+  std::unique_ptr<Landmarks> landmarks;  // nullptr without --landmarks
+};
+
+// `units`: the unit of both files (mm, cm or m); `landmark_file` empty: no landmarks.
+MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& units,
+                            const std::string& landmark_file);
+
+}  // namespace hexbite
