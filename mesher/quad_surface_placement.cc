@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <thread>
 #include <tuple>
 
 #include "common/error.h"
@@ -31,6 +33,25 @@ namespace {
 
 constexpr double kMinNormalAgreement = 0.2;
 constexpr double kSnapQuality = 0.3;  // feature snapping may lower a quad corner's scaled Jacobian to this
+
+// Calls f(i) for i in [0, n) in up to `threads` threads, each on a contiguous range. f must write only
+// what belongs to i (results are combined afterwards in index order, so they do not depend on threads).
+template <class F>
+void parallel_for(std::size_t n, int threads, const F& f, std::size_t min_chunk = 1024) {
+  const std::size_t t =
+      std::min<std::size_t>(std::clamp(threads, 1, 8), std::max<std::size_t>(1, n / min_chunk));
+  if (t <= 1) {
+    for (std::size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+  std::vector<std::thread> helpers;
+  for (std::size_t k = 1; k < t; ++k)
+    helpers.emplace_back([&, k] {
+      for (std::size_t i = n * k / t; i < n * (k + 1) / t; ++i) f(i);
+    });
+  for (std::size_t i = 0; i < n / t; ++i) f(i);
+  for (std::thread& h : helpers) h.join();
+}
 
 Vec3 unit(const Vec3& a) {
   const double n = norm(a);
@@ -59,6 +80,39 @@ Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
   return add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)));
 }
 
+// An axis-aligned box and whether it lies farther than `best` from p, with a margin far above the rounding
+// of the distances compared with best: a point in the box (a triangle's closest point to p, a grid point)
+// is then not closer to p than best, so a search keeping the first strictly closer candidate may skip it.
+struct Box {
+  Vec3 lo{}, hi{};
+};
+
+bool farther(const Box& b, const Vec3& p, double best) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::max({b.lo[k] - p[k], p[k] - b.hi[k], 0.0});
+    d2 += d * d;
+  }
+  const double limit = best + 1e-6 * (1.0 + best);
+  return d2 > limit * limit;
+}
+
+// The bounding box of triangle abc when closest_on_triangle() returns points on it to far better than
+// farther()'s margin; for a sliver (twice its area below 1e-3 of its longest edge squared), whose rounding
+// could put the point elsewhere, the whole space, so that it is never skipped.
+Box triangle_box(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double longest =
+      std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
+  if (!(norm(cross(sub(b, a), sub(c, a))) >= 1e-3 * longest))
+    return Box{{-1e300, -1e300, -1e300}, {1e300, 1e300, 1e300}};
+  Box box;
+  for (int k = 0; k < 3; ++k) {
+    box.lo[k] = std::min({a[k], b[k], c[k]});
+    box.hi[k] = std::max({a[k], b[k], c[k]});
+  }
+  return box;
+}
+
 // Closest surface point among the triangles whose outward normal agrees with a given direction: the
 // multi-patch restriction that keeps a node on its own side of a thin plate. A uniform grid of triangle
 // bounding boxes, searched in growing rings until no closer triangle can remain. Hand-written, with the
@@ -80,6 +134,7 @@ class OrientedProjector {
     }
     cells_.resize(static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2]);
     normals_.resize(s.triangles.size());
+    boxes_.resize(s.triangles.size());
     for (std::size_t t = 0; t < s.triangles.size(); ++t) {
       const Vec3 &a = s.vertices[s.triangles[t][0]], &b = s.vertices[s.triangles[t][1]],
                  &c = s.vertices[s.triangles[t][2]];
@@ -89,9 +144,22 @@ class OrientedProjector {
         i0[k] = cell_index(std::min({a[k], b[k], c[k]}), k);
         i1[k] = cell_index(std::max({a[k], b[k], c[k]}), k);
       }
+      boxes_[t] = triangle_box(a, b, c);
       for (int z = i0[2]; z <= i1[2]; ++z)
         for (int y = i0[1]; y <= i1[1]; ++y)
           for (int x = i0[0]; x <= i1[0]; ++x) cells_[flat(x, y, z)].push_back(static_cast<int>(t));
+    }
+    // The bounding box of each cell's triangles.
+    cell_boxes_.resize(cells_.size());
+    for (std::size_t i = 0; i < cells_.size(); ++i) {
+      Box& box = cell_boxes_[i];
+      box.lo = {1e300, 1e300, 1e300};
+      box.hi = {-1e300, -1e300, -1e300};
+      for (int t : cells_[i])
+        for (int k = 0; k < 3; ++k) {
+          box.lo[k] = std::min(box.lo[k], boxes_[t].lo[k]);
+          box.hi[k] = std::max(box.hi[k], boxes_[t].hi[k]);
+        }
     }
   }
 
@@ -120,9 +188,13 @@ class OrientedProjector {
           for (int x = c[0] - r; x <= c[0] + r; ++x) {
             if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;
             if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2]) continue;
+            // A triangle whose bounding box is farther than best cannot be strictly closer: skipping it
+            // (or a cell whose triangles all are) leaves the answer, ties included, as the full scan's.
+            if (farther(cell_boxes_[flat(x, y, z)], p, best)) continue;
             for (int t : cells_[flat(x, y, z)]) {
               if (dot(normals_[t], direction) <= kMinNormalAgreement || dot(normals_[t], previous) < 0)
                 continue;
+              if (farther(boxes_[t], p, best)) continue;
               const auto& tri = s_.triangles[t];
               const Vec3 q =
                   closest_on_triangle(p, s_.vertices[tri[0]], s_.vertices[tri[1]], s_.vertices[tri[2]]);
@@ -153,6 +225,8 @@ class OrientedProjector {
   std::array<int, 3> dims_{};
   std::vector<std::vector<int>> cells_;
   std::vector<Vec3> normals_;
+  std::vector<Box> boxes_;       // per triangle
+  std::vector<Box> cell_boxes_;  // per cell, of its triangles
 };
 
 // Nearest point of a fixed point set (the quad nodes of one relaxation sweep) among those a predicate
@@ -169,13 +243,68 @@ class PointGrid {
       }
     for (int a = 0; a < 3; ++a)
       dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo_[a]) / cell)) + 1);
-    cells_.resize(static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2]);
+    const std::size_t n = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+    // The points of cell k are items_[first_[k]] .. items_[first_[k + 1] - 1], in index order.
+    std::vector<std::size_t> cell_of(points.size());
+    first_.assign(n + 1, 0);
     for (std::size_t i = 0; i < points.size(); ++i) {
       std::array<int, 3> c;
       for (int a = 0; a < 3; ++a) c[a] = index(points[i][a], a);
-      cells_[(static_cast<std::size_t>(c[2]) * dims_[1] + c[1]) * dims_[0] + c[0]].push_back(
-          static_cast<int>(i));
+      cell_of[i] = flat(c[0], c[1], c[2]);
+      ++first_[cell_of[i] + 1];
     }
+    for (std::size_t k = 0; k < n; ++k) first_[k + 1] += first_[k];
+    items_.resize(points.size());
+    std::vector<std::size_t> next(first_.begin(), first_.end() - 1);
+    for (std::size_t i = 0; i < points.size(); ++i) items_[next[cell_of[i]]++] = static_cast<int>(i);
+    boxes_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      boxes_[k].lo = {1e300, 1e300, 1e300};
+      boxes_[k].hi = {-1e300, -1e300, -1e300};
+      for (std::size_t j = first_[k]; j < first_[k + 1]; ++j)
+        for (int a = 0; a < 3; ++a) {
+          boxes_[k].lo[a] = std::min(boxes_[k].lo[a], points_[items_[j]][a]);
+          boxes_[k].hi[a] = std::max(boxes_[k].hi[a], points_[items_[j]][a]);
+        }
+    }
+    // Per cell, bit (dz + 1) * 9 + (dy + 1) * 3 + (dx + 1) for each non-empty neighbour within the grid: the
+    // first ring visited in the same (z, y, x) order without the empty cells, which hold nothing.
+    neighbours_.assign(n, 0);
+    for (int z = 0; z < dims_[2]; ++z)
+      for (int y = 0; y < dims_[1]; ++y)
+        for (int x = 0; x < dims_[0]; ++x) {
+          std::uint32_t mask = 0;
+          for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const int u = x + dx, v = y + dy, w = z + dz;
+                if (u < 0 || v < 0 || w < 0 || u >= dims_[0] || v >= dims_[1] || w >= dims_[2]) continue;
+                const std::size_t k = flat(u, v, w);
+                if (first_[k + 1] > first_[k]) mask |= 1u << ((dz + 1) * 9 + (dy + 1) * 3 + (dx + 1));
+              }
+          neighbours_[flat(x, y, z)] = mask;
+        }
+  }
+
+  // Calls f(i) for every point i in the box [lo, hi], in no particular order.
+  template <class F>
+  void for_each_in_box(const Vec3& lo, const Vec3& hi, const F& f) const {
+    std::array<int, 3> c0, c1;
+    for (int a = 0; a < 3; ++a) {
+      c0[a] = index(lo[a], a);
+      c1[a] = index(hi[a], a);
+    }
+    for (int z = c0[2]; z <= c1[2]; ++z)
+      for (int y = c0[1]; y <= c1[1]; ++y)
+        for (int x = c0[0]; x <= c1[0]; ++x) {
+          const std::size_t k = flat(x, y, z);
+          for (std::size_t j = first_[k]; j < first_[k + 1]; ++j) {
+            const Vec3& p = points_[items_[j]];
+            if (p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] &&
+                p[2] <= hi[2])
+              f(items_[j]);
+          }
+        }
   }
 
   // -1 when no accepted point lies within `range`.
@@ -191,20 +320,38 @@ class PointGrid {
     outside = std::sqrt(outside);
     double best = range;
     int best_i = -1;
+    if (outside > best + 1e-6 * (1.0 + best)) return -1;  // every point is farther than range
+    auto visit = [&](std::size_t cell) {
+      if (farther(boxes_[cell], p, best)) return;  // no point of it is strictly nearer
+      for (std::size_t j = first_[cell]; j < first_[cell + 1]; ++j) {
+        const int i = items_[j];
+        const double d = norm(sub(points_[i], p));
+        if (d < best && accept(i)) {
+          best = d;
+          best_i = i;
+        }
+      }
+    };
     const int max_ring = std::max({dims_[0], dims_[1], dims_[2]});
+    const std::size_t centre = flat(c[0], c[1], c[2]);
     for (int r = 0; r <= max_ring; ++r) {
       if (best <= (r - 1) * cell_ - outside) break;
+      if (r == 0) {
+        visit(centre);
+        continue;
+      }
+      if (r == 1) {
+        for (std::uint32_t mask = neighbours_[centre] & ~(1u << 13); mask != 0; mask &= mask - 1) {
+          const int b = __builtin_ctz(mask);
+          visit(flat(c[0] + b % 3 - 1, c[1] + b / 3 % 3 - 1, c[2] + b / 9 - 1));
+        }
+        continue;
+      }
       for (int z = std::max(0, c[2] - r); z <= std::min(dims_[2] - 1, c[2] + r); ++z)
         for (int y = std::max(0, c[1] - r); y <= std::min(dims_[1] - 1, c[1] + r); ++y)
           for (int x = std::max(0, c[0] - r); x <= std::min(dims_[0] - 1, c[0] + r); ++x) {
             if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;
-            for (int i : cells_[(static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x]) {
-              const double d = norm(sub(points_[i], p));
-              if (d < best && accept(i)) {
-                best = d;
-                best_i = i;
-              }
-            }
+            visit(flat(x, y, z));
           }
     }
     return best_i;
@@ -214,11 +361,17 @@ class PointGrid {
   int index(double v, int a) const {
     return std::clamp(static_cast<int>(std::floor((v - lo_[a]) / cell_)), 0, dims_[a] - 1);
   }
+  std::size_t flat(int x, int y, int z) const {
+    return (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x;
+  }
   const std::vector<Vec3>& points_;
   double cell_;
   Vec3 lo_{};
   std::array<int, 3> dims_{};
-  std::vector<std::vector<int>> cells_;
+  std::vector<std::size_t> first_;
+  std::vector<int> items_;
+  std::vector<Box> boxes_;                 // per cell, of its points
+  std::vector<std::uint32_t> neighbours_;  // per cell, its non-empty neighbours
 };
 
 // Area-weighted vertex normals of a quad surface (each quad split along both diagonals).
@@ -448,8 +601,13 @@ Vec3 bilinear(const QuadSurface& q, const std::array<int, 4>& quad, double u, do
 // The input surface with what placement needs: closest-point queries (plain and restricted) and, per
 // input vertex, its area share and normal for the Lloyd step.
 struct PlacementSurface {
-  explicit PlacementSurface(const TriSurface& s)
-      : surface(s), projector(s), oriented(s), area(s.vertices.size(), 0.0), normal(s.vertices.size()) {
+  PlacementSurface(const TriSurface& s, int threads)
+      : surface(s),
+        projector(s),
+        oriented(s),
+        area(s.vertices.size(), 0.0),
+        normal(s.vertices.size()),
+        threads(threads) {
     for (const auto& t : s.triangles) {
       const Vec3 n = cross(sub(s.vertices[t[1]], s.vertices[t[0]]), sub(s.vertices[t[2]], s.vertices[t[0]]));
       for (int v : t) {
@@ -464,6 +622,7 @@ struct PlacementSurface {
   OrientedProjector oriented;
   std::vector<double> area;
   std::vector<Vec3> normal;
+  int threads;  // of the per-input-vertex loops
 };
 
 // Restricted projection of every node (normal agreement with the quad mesh's vertex normal); returns the
@@ -490,6 +649,13 @@ void relax(QuadSurface& fine, const PlacementSurface& s, const std::vector<char>
   std::vector<std::vector<int>> vertex_quads(fine.vertices.size());
   for (std::size_t q = 0; q < fine.quads.size(); ++q)
     for (int v : fine.quads[q]) vertex_quads[v].push_back(static_cast<int>(q));
+  // Only the regions of the free nodes are used. When few nodes are free (step 9 relaxes the rings only),
+  // an input vertex whose nearest node was a fixed one (fixed nodes stay put), w, is not searched again
+  // while w is still accepted and no free node is as near as w: the search would give a fixed node.
+  std::size_t free_count = 0;
+  for (char f : fixed) free_count += !f;
+  const bool witnesses = 2 * free_count < fixed.size();
+  std::vector<int> witness(witnesses ? s.surface.vertices.size() : 0, -1);
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     const std::vector<Vec3> normals = vertex_normals(fine);
     std::vector<Vec3> centroid(fine.quads.size());
@@ -497,9 +663,27 @@ void relax(QuadSurface& fine, const PlacementSurface& s, const std::vector<char>
     std::vector<Vec3> region(fine.vertices.size(), Vec3{0, 0, 0});
     std::vector<double> region_area(fine.vertices.size(), 0.0);
     const PointGrid grid(fine.vertices, 4.0);
+    std::vector<Vec3> free_points;
+    for (std::size_t v = 0; v < fine.vertices.size(); ++v)
+      if (witnesses && !fixed[v]) free_points.push_back(fine.vertices[v]);
+    const PointGrid free_grid(free_points, 4.0);
+    std::vector<int> nearest(s.surface.vertices.size());
+    parallel_for(nearest.size(), s.threads, [&](std::size_t i) {
+      const Vec3& p = s.surface.vertices[i];
+      auto accept = [&](int j) { return dot(normals[j], s.normal[i]) > kMinNormalAgreement; };
+      if (witnesses && witness[i] >= 0 && accept(witness[i])) {
+        // The same distance as the search computes for w; a free node counts when not farther.
+        const double d = norm(sub(fine.vertices[witness[i]], p));
+        if (free_grid.nearest(p, std::nextafter(d, 1e300), [](int) { return true; }) < 0) {
+          nearest[i] = -1;  // a fixed node, whose region is not used
+          return;
+        }
+      }
+      nearest[i] = grid.nearest(p, 20.0, accept);
+      if (witnesses) witness[i] = nearest[i] >= 0 && fixed[nearest[i]] ? nearest[i] : -1;
+    });
     for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
-      const int v = grid.nearest(s.surface.vertices[i], 20.0,
-                                 [&](int j) { return dot(normals[j], s.normal[i]) > kMinNormalAgreement; });
+      const int v = nearest[i];
       if (v < 0) continue;
       region[v] = add(region[v], scale(s.surface.vertices[i], s.area[i]));
       region_area[v] += s.area[i];
@@ -670,19 +854,39 @@ double corner_jacobian(const QuadSurface& q, const std::array<int, 4>& quad, int
 // distance of the vertex and of the input vertices charged to those quads (nearest to them) to them, and
 // of their inner sample points to the input. Snapped nodes stay fixed. Each round re-measures; up to
 // `rounds` rounds, stopping when a round moves nothing.
+// *settled: the distances of the input vertices to the quads as returned, when the last round measured them
+// on these quads (it moved nothing), -1 for those only known to lie nearer than threshold_mm; else empty.
 void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<char>& fixed, int rounds,
-                   double threshold_mm, std::vector<Vec3>* surface_normal) {
+                   double threshold_mm, std::vector<Vec3>* surface_normal, std::vector<double>* settled) {
+  settled->clear();
   std::vector<std::vector<int>> vertex_quads(fine.vertices.size());
   for (std::size_t q = 0; q < fine.quads.size(); ++q)
     for (int v : fine.quads[q]) vertex_quads[v].push_back(static_cast<int>(q));
-  auto distance_to_quads = [&](const Vec3& p, const std::vector<int>& quads) {
-    double best = std::numeric_limits<double>::infinity();
+  // The fan triangles of some quads (corner, next corner, centre), with their bounding boxes.
+  struct Fan {
+    std::vector<std::array<Vec3, 3>> triangles;
+    std::vector<Box> boxes;
+  };
+  auto fan_of = [&](const std::vector<int>& quads) {
+    Fan f;
     for (int q : quads) {
       const auto& quad = fine.quads[q];
       const Vec3 centre = bilinear(fine, quad, 0.5, 0.5);
-      for (int k = 0; k < 4; ++k)
-        best = std::min(best, norm(sub(p, closest_on_triangle(p, fine.vertices[quad[k]],
-                                                              fine.vertices[quad[(k + 1) % 4]], centre))));
+      for (int k = 0; k < 4; ++k) {
+        f.triangles.push_back({fine.vertices[quad[k]], fine.vertices[quad[(k + 1) % 4]], centre});
+        f.boxes.push_back(triangle_box(f.triangles.back()[0], f.triangles.back()[1], centre));
+      }
+    }
+    return f;
+  };
+  // The distance of p to those quads: the smallest over the triangles (a triangle whose box lies farther
+  // than the smallest so far cannot lower it, so skipping it leaves the same value).
+  auto distance_to_fan = [&](const Vec3& p, const Fan& f) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < f.triangles.size(); ++t) {
+      if (farther(f.boxes[t], p, best)) continue;
+      const auto& tri = f.triangles[t];
+      best = std::min(best, norm(sub(p, closest_on_triangle(p, tri[0], tri[1], tri[2]))));
     }
     return best;
   };
@@ -694,35 +898,133 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
         e = std::max(e, s.projector.distance(bilinear(fine, fine.quads[q], a / 4.0, b / 4.0)));
     return e;
   };
+  // The part of a node's local error and quality that does not depend on the input vertex pulling it (the
+  // charged vertices' distances, the smallest corner scaled Jacobian), cached per node: valid while no move
+  // has been kept since (a rejected move restores every value it changed).
+  std::vector<double> cached_charged(fine.vertices.size()), cached_quality(fine.vertices.size());
+  std::vector<long> cached_at(fine.vertices.size(), -1);
+  long state = 0;  // bumped by every kept move and every round
+  // Per input vertex: its quad (the closest-point query's triangle / 4) and distance, from the latest
+  // round that queried it.
+  std::vector<int> nearest_quad(s.surface.vertices.size(), -1);
+  std::vector<double> distance(s.surface.vertices.size());
+  // The input vertices in a uniform grid, to find those near a quad.
+  const PointGrid vertex_grid(s.surface.vertices, 2.0);
+  constexpr double kBoundMargin = 1e-6;  // mm, far above the rounding of the distances compared
+  // The sampled error of each quad, kept up to date by the kept moves (the only changes of the quads), so
+  // measured once rather than every round.
+  std::vector<double> sample_error(fine.quads.size());
+  parallel_for(
+      fine.quads.size(), s.threads,
+      [&](std::size_t q) { sample_error[q] = sampled_error(static_cast<int>(q)); }, 64);
   for (int round = 0; round < rounds; ++round) {
-    const SurfaceProjector quad_projector(fan_triangles(fine));
+    ++state;
+    const TriSurface fan = fan_triangles(fine);
+    const SurfaceProjector quad_projector(fan);
     std::vector<std::vector<int>> charged(fine.quads.size());
     std::vector<std::pair<double, int>> far;
-    for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
+    // Only two things of the queries are used: which input vertices are far (farther than threshold_mm),
+    // and the charged lists of the quads around the nodes those far vertices may pull. A vertex within
+    // threshold_mm - kBoundMargin of the quad it had last round (an upper bound of its distance to the
+    // quads) is not far; and it can be charged to a quad only if it lies within that bound of the quad's
+    // bounding box. So only the other vertices, and those near the quads whose lists are read, are queried
+    // (the first round queries all); the queried answers, far list and lists read are the full scan's.
+    // Slivers among the fan triangles (a degenerate quad) could put a closest point off its triangle by
+    // more than the margin: then every vertex is queried.
+    bool bounded = true;
+    for (const auto& t : fan.triangles)
+      bounded =
+          bounded && triangle_box(fan.vertices[t[0]], fan.vertices[t[1]], fan.vertices[t[2]]).lo[0] > -1e300;
+    std::vector<char> queried(s.surface.vertices.size(), 0);
+    // The distance of p to the fan triangles of quad q (to well within kBoundMargin when bounded).
+    auto quad_distance = [&](const Vec3& p, int q) {
+      double d = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 4; ++k) {
+        const auto& t = fan.triangles[4 * q + k];
+        d = std::min(
+            d,
+            norm(sub(p, closest_on_triangle(p, fan.vertices[t[0]], fan.vertices[t[1]], fan.vertices[t[2]]))));
+      }
+      return d;
+    };
+    std::vector<double> bound(s.surface.vertices.size());  // of the unqueried vertices' distances
+    parallel_for(s.surface.vertices.size(), s.threads, [&](std::size_t i) {
+      const Vec3& p = s.surface.vertices[i];
+      if (bounded && nearest_quad[i] >= 0) {
+        bound[i] = quad_distance(p, nearest_quad[i]);
+        if (bound[i] <= threshold_mm - kBoundMargin) return;
+      }
+      const SurfacePoint sp = quad_projector.closest(p);
+      nearest_quad[i] = sp.triangle / 4;
+      distance[i] = sp.distance;
+      queried[i] = 1;
+    });
+    // The quads whose charged lists may be read: those around the free nodes of the far vertices' quads.
+    std::vector<char> read(fine.quads.size(), 0);
+    for (std::size_t i = 0; i < s.surface.vertices.size(); ++i)
+      if (queried[i] && distance[i] > threshold_mm)
+        for (int v : fine.quads[nearest_quad[i]])
+          for (int q : vertex_quads[v]) read[q] = 1;
+    std::vector<char> near_read(s.surface.vertices.size(), 0);
+    for (std::size_t q = 0; q < fine.quads.size(); ++q) {
+      if (!read[q]) continue;
+      Box box{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+      for (int k = 0; k < 4; ++k)
+        for (int c : fan.triangles[4 * q + k])
+          for (int a = 0; a < 3; ++a) {
+            box.lo[a] = std::min(box.lo[a], fan.vertices[c][a]);
+            box.hi[a] = std::max(box.hi[a], fan.vertices[c][a]);
+          }
+      for (int a = 0; a < 3; ++a) {
+        box.lo[a] -= threshold_mm + kBoundMargin;
+        box.hi[a] += threshold_mm + kBoundMargin;
+      }
+      vertex_grid.for_each_in_box(box.lo, box.hi, [&](int i) {
+        // Its closest point lies on quad q only if q is within its distance bound.
+        if (!queried[i] && !near_read[i] &&
+            quad_distance(s.surface.vertices[i], static_cast<int>(q)) <= bound[i] + kBoundMargin)
+          near_read[i] = 1;
+      });
+    }
+    parallel_for(s.surface.vertices.size(), s.threads, [&](std::size_t i) {
+      if (queried[i] || !near_read[i]) return;
       const SurfacePoint sp = quad_projector.closest(s.surface.vertices[i]);
-      charged[sp.triangle / 4].push_back(static_cast<int>(i));
-      if (sp.distance > threshold_mm) far.push_back({-sp.distance, static_cast<int>(i)});
+      nearest_quad[i] = sp.triangle / 4;
+      distance[i] = sp.distance;
+      queried[i] = 1;
+    });
+    bool all = true;
+    for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
+      if (!queried[i]) {
+        all = false;
+        continue;
+      }
+      charged[nearest_quad[i]].push_back(static_cast<int>(i));
+      if (distance[i] > threshold_mm) far.push_back({-distance[i], static_cast<int>(i)});
     }
     std::sort(far.begin(), far.end());
-    std::vector<double> sample_error(fine.quads.size());
-    for (std::size_t q = 0; q < fine.quads.size(); ++q) sample_error[q] = sampled_error(static_cast<int>(q));
     std::vector<char> touched(fine.quads.size(), 0);
     int moved = 0;
     for (const auto& [negative_distance, i] : far) {
       const Vec3& p = s.surface.vertices[i];
-      const SurfacePoint sp = quad_projector.closest(p);
-      const int q0 = sp.triangle / 4;
-      if (touched[q0]) continue;  // its quads changed this round: the distances are stale
+      const int q0 = nearest_quad[i];  // the same query as above, on the same quads
+      if (touched[q0]) continue;       // its quads changed this round: the distances are stale
       // Moves v to goal if that keeps the local quality and lowers the local error (then v is fixed).
       auto try_move = [&](int v, const Vec3& goal) {
         const std::vector<int>& quads = vertex_quads[v];
         // Local error: the largest distance of p and of the input vertices charged to v's quads to those
         // quads, and of the quads' sampled points to the input (cached per quad); local quality: the
         // smallest corner scaled Jacobian of v's quads.
-        auto charged_error = [&]() {
-          double e = distance_to_quads(p, quads);
+        // The largest distance of the charged vertices; once it reaches `stop`, that value (a larger one
+        // does not matter to the caller).
+        auto charged_max = [&](double stop) {
+          const Fan fan = fan_of(quads);
+          double e = 0;
           for (int q : quads)
-            for (int j : charged[q]) e = std::max(e, distance_to_quads(s.surface.vertices[j], quads));
+            for (int j : charged[q]) {
+              e = std::max(e, distance_to_fan(s.surface.vertices[j], fan));
+              if (e >= stop) return e;
+            }
           return e;
         };
         auto quality = [&]() {
@@ -732,13 +1034,23 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
               m = std::min(m, corner_jacobian(fine, fine.quads[q], k, *surface_normal));
           return m;
         };
-        double before = charged_error();
+        if (cached_at[v] != state) {
+          cached_charged[v] = charged_max(std::numeric_limits<double>::infinity());
+          cached_quality[v] = quality();
+          cached_at[v] = state;
+        }
+        // The maximum is exact in any order: the same value as p's distance, then the charged ones.
+        double before = std::max(distance_to_fan(p, fan_of(quads)), cached_charged[v]);
         for (int q : quads) before = std::max(before, sample_error[q]);
-        const double before_quality = quality();
+        const double before_quality = cached_quality[v];
         const Vec3 old_point = fine.vertices[v], old_normal = (*surface_normal)[v];
         fine.vertices[v] = goal;
         (*surface_normal)[v] = s.projector.closest(goal).normal;
-        if (quality() >= std::min(before_quality, kSnapQuality) && charged_error() < before - 1e-6) {
+        auto lowers_error = [&]() {
+          const double limit = before - 1e-6;
+          return distance_to_fan(p, fan_of(quads)) < limit && charged_max(limit) < limit;
+        };
+        if (quality() >= std::min(before_quality, kSnapQuality) && lowers_error()) {
           std::vector<double> after_samples;
           double after = 0;
           for (int q : quads) {
@@ -752,6 +1064,7 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
             }
             fixed[v] = 1;
             ++moved;
+            ++state;
             return true;
           }
         }
@@ -781,7 +1094,13 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
         }
       }
     }
-    if (moved == 0) break;
+    if (moved == 0) {
+      // The vertices not queried this round are nearer than threshold_mm: -1 stands for their distance.
+      for (std::size_t i = 0; i < distance.size(); ++i)
+        if (!queried[i]) distance[i] = -1;
+      settled->swap(distance);
+      break;
+    }
   }
 }
 
@@ -789,8 +1108,22 @@ void snap_features(QuadSurface& fine, const PlacementSurface& s, std::vector<cha
 // the quads, and the closest surface points of quad sample points (5 x 5 per quad, as step 10) farther
 // than that from the input, each with its distance; farthest first), the Hausdorff distance and the
 // centres of the folded quads (as step 10 counts them).
+// Whether distances of the input vertices to the quads, -1 for those only known to lie nearer than
+// threshold_mm, give the largest distance and its first vertex: when one of them is farther than that.
+bool complete_enough(const std::vector<double>& distance, double threshold_mm) {
+  if (distance.empty()) return false;
+  double largest = 0;
+  bool unknown = false;
+  for (double d : distance) {
+    largest = std::max(largest, d);
+    unknown = unknown || d < 0;
+  }
+  return !unknown || largest > threshold_mm;
+}
+
 struct FarPoints {
   std::vector<std::pair<double, Vec3>> far;  // (-distance, point)
+  std::vector<double> input_distance;        // of each input vertex to the quads
   double hausdorff = 0;
   std::vector<Vec3> folded;
   // The largest distance of the far points within `radius` of p (0 when there is none).
@@ -802,26 +1135,48 @@ struct FarPoints {
   }
 };
 
-FarPoints measure_far(const QuadSurface& fine, const PlacementSurface& s, double threshold_mm) {
+// known: the distances of the input vertices to these quads when snap_features() measured them (the same
+// closest-point queries on the same tree: SurfaceProjector::distance() is closest().distance, bit for bit;
+// -1 for a vertex nearer than threshold_mm), or empty. Measured afresh unless complete_enough().
+FarPoints measure_far(const QuadSurface& fine, const PlacementSurface& s, double threshold_mm,
+                      std::vector<double> known) {
   FarPoints r;
-  const SurfaceProjector quad_projector(fan_triangles(fine));
-  for (const Vec3& v : s.surface.vertices) {
-    const double d = quad_projector.distance(v);
-    r.hausdorff = std::max(r.hausdorff, d);
-    if (d > threshold_mm) r.far.push_back({-d, v});
+  r.input_distance = std::move(known);
+  if (!complete_enough(r.input_distance, threshold_mm)) {
+    const SurfaceProjector quad_projector(fan_triangles(fine));
+    r.input_distance.resize(s.surface.vertices.size());
+    parallel_for(s.surface.vertices.size(), s.threads, [&](std::size_t i) {
+      r.input_distance[i] = quad_projector.distance(s.surface.vertices[i]);
+    });
   }
-  for (const auto& quad : fine.quads) {
-    for (int j = 0; j <= 4; ++j)
-      for (int i = 0; i <= 4; ++i) {
-        const SurfacePoint sp = s.projector.closest(bilinear(fine, quad, i / 4.0, j / 4.0));
-        r.hausdorff = std::max(r.hausdorff, sp.distance);
-        if (sp.distance > threshold_mm) r.far.push_back({-sp.distance, sp.point});
-      }
+  for (std::size_t i = 0; i < s.surface.vertices.size(); ++i) {
+    const double d = r.input_distance[i];
+    r.hausdorff = std::max(r.hausdorff, d);
+    if (d > threshold_mm) r.far.push_back({-d, s.surface.vertices[i]});
+  }
+  // The 25 sample points of each quad and the input normals at its corners, then in quad order.
+  std::vector<SurfacePoint> samples(fine.quads.size() * 25);
+  std::vector<Vec3> corner_normal(fine.quads.size() * 4);
+  parallel_for(fine.quads.size() * 29, s.threads, [&](std::size_t n) {
+    const auto& quad = fine.quads[n / 29];
+    const int m = static_cast<int>(n % 29);
+    if (m < 25)
+      samples[n / 29 * 25 + m] = s.projector.closest(bilinear(fine, quad, (m % 5) / 4.0, (m / 5) / 4.0));
+    else
+      corner_normal[n / 29 * 4 + (m - 25)] = s.projector.closest(fine.vertices[quad[m - 25]]).normal;
+  });
+  for (std::size_t q = 0; q < fine.quads.size(); ++q) {
+    const auto& quad = fine.quads[q];
+    for (int m = 0; m < 25; ++m) {
+      const SurfacePoint& sp = samples[q * 25 + m];
+      r.hausdorff = std::max(r.hausdorff, sp.distance);
+      if (sp.distance > threshold_mm) r.far.push_back({-sp.distance, sp.point});
+    }
     for (int k = 0; k < 4; ++k) {
       const Vec3& p = fine.vertices[quad[k]];
       const Vec3 n =
           cross(sub(fine.vertices[quad[(k + 1) % 4]], p), sub(fine.vertices[quad[(k + 3) % 4]], p));
-      if (dot(n, s.projector.closest(p).normal) <= 0) {
+      if (dot(n, corner_normal[q * 4 + k]) <= 0) {
         r.folded.push_back(bilinear(fine, quad, 0.5, 0.5));
         break;
       }
@@ -842,11 +1197,14 @@ FarPoints measure_far(const QuadSurface& fine, const PlacementSurface& s, double
 // get nearer, are dropped and the round is redone from the surface before it (up to fidelity_passes
 // times); a round whose centres all stay is kept when it lowers the Hausdorff distance without more folded
 // quads, else the refinement stops. The rungs of kept rings go to report->ring_rungs, latest first.
+// settled: as snap_features() gives it for `fine`; on return, the distances of the input vertices to the
+// returned quads.
 void refine_for_fidelity(QuadSurface& fine, const PlacementSurface& s, std::vector<char>& fixed,
                          std::vector<Vec3>* surface_normal, const MandibleQuadOptions& o,
-                         MandibleQuadReport* report) {
+                         MandibleQuadReport* report, std::vector<double>* settled) {
   report->fidelity_goal_mm = o.snap_threshold_mm;
-  FarPoints current = measure_far(fine, s, o.snap_threshold_mm);
+  FarPoints current = measure_far(fine, s, o.snap_threshold_mm, std::move(*settled));
+  *settled = current.input_distance;
   if (current.hausdorff > o.max_hausdorff_mm) return;  // not a mandible: step 10 rejects it
   const int quads_before = static_cast<int>(fine.quads.size());
   const QuadSurface fine_before = fine;
@@ -887,8 +1245,9 @@ void refine_for_fidelity(QuadSurface& fine, const PlacementSurface& s, std::vect
         trial_normal[v] = s.projector.closest(trial.vertices[v]).normal;
       relax(trial, s, frozen, o.fidelity_relax_sweeps, &trial_normal);
       unfold(trial, s, trial_fixed, o.unfold_sweeps, &trial_normal);
-      snap_features(trial, s, trial_fixed, o.snap_rounds, o.snap_threshold_mm, &trial_normal);
-      const FarPoints next = measure_far(trial, s, o.snap_threshold_mm);
+      std::vector<double> trial_settled;
+      snap_features(trial, s, trial_fixed, o.snap_rounds, o.snap_threshold_mm, &trial_normal, &trial_settled);
+      const FarPoints next = measure_far(trial, s, o.snap_threshold_mm, std::move(trial_settled));
       std::vector<Vec3> kept;
       for (const Vec3& p : refinement.points)
         if (std::none_of(next.folded.begin(), next.folded.end(),
@@ -923,6 +1282,8 @@ void refine_for_fidelity(QuadSurface& fine, const PlacementSurface& s, std::vect
     report->ring_rungs.clear();
     report->fidelity_undone_rounds = report->fidelity_rounds;
     report->fidelity_rounds = 0;
+  } else {
+    *settled = current.input_distance;
   }
   report->fidelity_quads_added = static_cast<int>(fine.quads.size()) - quads_before;
 }
@@ -1026,7 +1387,7 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   // 4. Refinement and restricted projection.
   QuadSurface fine = refine(macro, macro_edges, edge_count);
   std::vector<char> fixed(fine.vertices.size(), 0);
-  const PlacementSurface target(surface);
+  const PlacementSurface target(surface, options.threads);
   const SurfaceProjector& projector = target.projector;
   std::vector<Vec3> surface_normal = project(fine, target);
   progress.update(0.3, "refined");
@@ -1054,11 +1415,13 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   // 6-8. Relaxation, untangling and feature snapping on the target.
   relax(fine, target, fixed, options.relax_sweeps, &surface_normal);
   unfold(fine, target, fixed, options.unfold_sweeps, &surface_normal);
-  snap_features(fine, target, fixed, options.snap_rounds, options.snap_threshold_mm, &surface_normal);
+  std::vector<double> settled;  // distances of the input vertices to the quads, when known
+  snap_features(fine, target, fixed, options.snap_rounds, options.snap_threshold_mm, &surface_normal,
+                &settled);
   progress.update(0.8, "relaxed");
 
   // 9. Fidelity refinement: one ring of quads around the regions still far from the quads, then snapping.
-  refine_for_fidelity(fine, target, fixed, &surface_normal, options, &report);
+  refine_for_fidelity(fine, target, fixed, &surface_normal, options, &report, &settled);
   progress.update(0.9, "refined for fidelity");
 
   // 10. Fidelity.
@@ -1079,13 +1442,18 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
           worst_quad = p;
         }
       }
-  const SurfaceProjector quad_projector(fan_triangles(fine));
+  if (!complete_enough(settled, options.snap_threshold_mm)) {
+    const SurfaceProjector quad_projector(fan_triangles(fine));
+    settled.resize(surface.vertices.size());
+    parallel_for(surface.vertices.size(), options.threads,
+                 [&](std::size_t i) { settled[i] = quad_projector.distance(surface.vertices[i]); });
+  }
   Vec3 worst_surface{0, 0, 0};
-  for (const Vec3& v : surface.vertices) {
-    const double d = quad_projector.distance(v);
+  for (std::size_t i = 0; i < surface.vertices.size(); ++i) {
+    const double d = settled[i];
     if (d > report.surface_to_quads_mm) {
       report.surface_to_quads_mm = d;
-      worst_surface = v;
+      worst_surface = surface.vertices[i];
     }
   }
   report.hausdorff_mm = std::max(report.quads_to_surface_mm, report.surface_to_quads_mm);
