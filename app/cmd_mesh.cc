@@ -37,9 +37,6 @@ namespace hexbite {
 
 namespace {
 
-constexpr long kMinTarget = 8;
-constexpr long kMaxTarget = 5000000;
-
 struct MeshOptions {
   std::string surface;
   std::string method = "grid";
@@ -229,7 +226,7 @@ void add_mesh_command(CLI::App& app) {
       ->check(CLI::IsMember({"grid", "sheets"}));
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")
       ->default_val(2500)
-      ->transform(count_in_range(kMinTarget, kMaxTarget));
+      ->transform(count_in_range(kMinTargetHexes, kMaxTargetHexes));
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required()->check(output_file({".vtu"}));
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   CLI::Option* margin =

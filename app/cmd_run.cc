@@ -20,6 +20,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/tri_surface.h"
 #include "solver/mpi_session.h"
 
 namespace hexbite {
@@ -29,6 +30,12 @@ namespace {
 // Applied forces plus reactions must vanish; the solver's tolerance (1e-10 by default) leaves residuals
 // of order 1e-11, so 1e-8 separates a converged solve from wrong bookkeeping with a wide margin.
 constexpr double kEquilibriumTolerance = 1e-8;
+
+// Linear elasticity assumes displacements small against the body: a largest displacement beyond this
+// fraction of the bone's size (about 10 mm on a mandible, whose bite moves it by about 0.1 mm) comes from
+// a Young's modulus or a force in the wrong unit, or from supports that barely hold the bone, and the
+// figures mean nothing.
+constexpr double kMaxDisplacementFraction = 0.1;
 
 struct RunCliOptions {
   std::string scenario;
@@ -68,11 +75,23 @@ void run_run(const RunCliOptions& o) {
     std::cout << " (" << total << " s in all)\n";
   }
 
-  for (const LevelResult& l : result.levels)
+  const double size = largest_extent(result.levels.front().mesh.vertices);
+  for (const LevelResult& l : result.levels) {
     if (!(l.solution.equilibrium_residual <= kEquilibriumTolerance))
       throw RunError("level " + std::to_string(l.level) + ": applied forces and reactions do not balance (" +
                      "relative residual " + std::to_string(l.solution.equilibrium_residual) + " > 1e-8); " +
                      "the results in " + o.output + " are not trustworthy: tighten solver.tolerance");
+    if (l.solution.max_displacement > kMaxDisplacementFraction * size) {
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    "level %d: the largest displacement, %.3g mm, is more than %.0f %% of the bone's size "
+                    "(%.1f mm), but linear elasticity holds only for small displacements",
+                    l.level, l.solution.max_displacement, 100 * kMaxDisplacementFraction, size);
+      throw RunError(std::string(text) + "; the results in " + o.output +
+                     " are meaningless: check materials E_MPa (in MPa, cortical bone about 11000), the "
+                     "muscles' max_force_N (in N) and that the supports hold the bone");
+    }
+  }
 }
 
 }  // namespace

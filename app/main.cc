@@ -1,10 +1,16 @@
 // The hexbite command line: parses options with CLI11 and maps errors to exit codes
 // (0 ok, 1 failed run, 2 bad input or usage). MPI is initialized here for the commands that solve, so that
 // `mpirun -np N hexbite run ...` works; without mpirun the program is a single rank.
+#include <mpi.h>
+
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <functional>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <thread>
 
 #include "app/commands.h"
 #include "common/error.h"
@@ -28,15 +34,51 @@ bool command_uses_solver(int argc, char** argv) {
   return false;
 }
 
+// Prints an error's `text` (whole lines) and returns its exit code. Under mpirun every rank reads the same
+// command line and scenario and builds the same meshes, so such an error stops all of them with the same
+// text: rank 0 alone prints it then. An error of one rank (the others did not fail within a few seconds, or
+// failed otherwise) is printed with its rank, and when the others did not fail, the job is aborted: they
+// wait in a collective call of the run that this rank will never join, and MPI_Finalize would wait for
+// them. `errors` is a communicator of its own, so that the barrier below cannot meet a collective call of
+// the run.
+int report(const std::string& text, int exit_code, MPI_Comm errors) {
+  const int ranks = hexbite::MpiSession::size(), rank = hexbite::MpiSession::rank();
+  if (ranks < 2) {
+    std::cerr << text;
+    return exit_code;
+  }
+  const std::string own = "[rank " + std::to_string(rank) + "] " + text;
+  MPI_Request barrier;
+  MPI_Ibarrier(errors, &barrier);
+  int all_failed = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (MPI_Test(&barrier, &all_failed, MPI_STATUS_IGNORE) == MPI_SUCCESS && !all_failed &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (!all_failed) {
+    std::cerr << own << std::flush;
+    MPI_Abort(MPI_COMM_WORLD, exit_code);
+  }
+  const unsigned long hash = std::hash<std::string>{}(text);
+  unsigned long lowest = 0, highest = 0;
+  MPI_Allreduce(&hash, &lowest, 1, MPI_UNSIGNED_LONG, MPI_MIN, errors);
+  MPI_Allreduce(&hash, &highest, 1, MPI_UNSIGNED_LONG, MPI_MAX, errors);
+  if (lowest != highest)
+    std::cerr << own;
+  else if (rank == 0)
+    std::cerr << text;
+  return exit_code;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::optional<hexbite::MpiSession> mpi;
   if (command_uses_solver(argc, argv)) mpi.emplace(argc, argv);
-  // Only rank 0 reports progress and results; errors are reported by every rank that meets them.
+  // Only rank 0 reports progress and results; an error met by every rank alike is reported once (report).
   const bool root = hexbite::MpiSession::rank() == 0;
-  const std::string rank_prefix =
-      hexbite::MpiSession::size() > 1 ? "[rank " + std::to_string(hexbite::MpiSession::rank()) + "] " : "";
+  MPI_Comm errors = MPI_COMM_NULL;
+  if (hexbite::MpiSession::size() > 1) MPI_Comm_dup(MPI_COMM_WORLD, &errors);
   CLI::App app{"hexbite: hexahedral meshing and bite simulation of the human mandible"};
   app.set_version_flag("--version", std::string("hexbite ") + HEXBITE_VERSION);
   bool quiet = false;
@@ -64,17 +106,15 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);  // prints the message and a hint to --help
-    return hexbite::kExitBadInput;
+    std::ostringstream text;
+    app.exit(e, text, text);  // the message and a hint to --help
+    return report(text.str(), hexbite::kExitBadInput, errors);
   } catch (const hexbite::InputError& e) {
-    std::cerr << rank_prefix << "hexbite: error: " << e.what() << '\n';
-    return hexbite::kExitBadInput;
+    return report(std::string("hexbite: error: ") + e.what() + '\n', hexbite::kExitBadInput, errors);
   } catch (const hexbite::RunError& e) {
-    std::cerr << rank_prefix << "hexbite: failed: " << e.what() << '\n';
-    return hexbite::kExitRunFailed;
+    return report(std::string("hexbite: failed: ") + e.what() + '\n', hexbite::kExitRunFailed, errors);
   } catch (const std::exception& e) {
-    std::cerr << rank_prefix << "hexbite: failed: " << e.what() << '\n';
-    return hexbite::kExitRunFailed;
+    return report(std::string("hexbite: failed: ") + e.what() + '\n', hexbite::kExitRunFailed, errors);
   }
   return hexbite::kExitOk;
 }

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <regex>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -334,6 +335,30 @@ json results_json(const RunResult& r, double seconds_output) {
   return j;
 }
 
+namespace {
+
+// The files of an earlier run into the same folder that this run does not rewrite (the
+// solution_level2.vtu of a run with more levels, a model.inp of a run with --export inp, the pieces of
+// another rank count) would pass for this run's: they are removed. Other files are left alone.
+void remove_stale_outputs(const std::string& dir, const std::vector<std::string>& written) {
+  static const std::regex kOutputName(
+      R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (!std::regex_match(name, kOutputName) ||
+        std::find(written.begin(), written.end(), name) != written.end())
+      continue;
+    std::error_code ec;
+    fs::remove(entry.path(), ec);
+    if (ec)
+      throw RunError("cannot remove " + entry.path().string() +
+                     ", left by an earlier run and not rewritten " + "by this one: " + ec.message() +
+                     "; remove it or choose another output folder");
+  }
+}
+
+}  // namespace
+
 std::vector<std::string> write_run_outputs(const RunResult& r, const std::string& dir, bool export_inp) {
   const bool vtu = r.scenario.outputs.vtu;
   const int rank = MpiSession::rank();
@@ -362,6 +387,7 @@ std::vector<std::string> write_run_outputs(const RunResult& r, const std::string
     written.insert(written.end(), files.begin(), files.end());
   }
   MPI_Barrier(MPI_COMM_WORLD);
+  if (rank == 0) remove_stale_outputs(dir, written);
   return written;
 }
 

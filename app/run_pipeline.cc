@@ -8,6 +8,10 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <set>
+#include <string>
+
+#include <unistd.h>
 
 #include "common/error.h"
 #include "common/progress.h"
@@ -154,8 +158,13 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     mesh = mesh_mandible_by_sheets(geometry.surface, has_landmarks ? &geometry.landmarks : nullptr, options,
                                    &report);
   } catch (const InputError& e) {
-    // A bite point off the bone: the message already names the support's line and the key.
-    if (std::string(e.what()).find("(mesh.refine_at_bite)") != std::string::npos) throw;
+    // A bite point off the bone: the message names the support's line and the key, after the mesher's
+    // name of the surface, which goes, so that the line comes first as in every scenario error.
+    const std::string what = e.what();
+    for (const Support& support : s.supports) {
+      const std::size_t at = what.find(support.at.where.str() + ": the bite support");
+      if (at != std::string::npos) throw InputError(what.substr(at));
+    }
     throw InputError(
         s.mesh.method_at.str() + ": mesh.method 'sheets' cannot place its mandible template: " + e.what() +
         "; give landmarks with the template's points, or use method: grid for a bone that is not a "
@@ -211,6 +220,39 @@ long long count_dofs(const HexMesh& mesh, int degree) {
     nodes += static_cast<long long>(mesh.hexes.size());
   }
   return 3 * nodes;
+}
+
+// Peak memory of a solve per degree of freedom, matrix and AMG hierarchy included (docs/solver.md: 5.1 kB
+// measured on a Q1 block of 204,828 DoFs).
+constexpr double kBytesPerDof = 5e3;
+
+// Each validation level multiplies the problem by 8 (a Q2 problem of the shipped 4,000 hexes has 7 million
+// DoFs at level 2): a last level whose solve needs more than this machine's memory, even shared by all
+// ranks, is refused before the refinement, instead of ending minutes later in bad_alloc or the kernel's
+// out-of-memory kill.
+void require_levels_fit_memory(const Scenario& s, const HexMesh& coarse, int levels) {
+  if (levels == 0) return;
+  const double dofs = static_cast<double>(count_dofs(coarse, s.solver.degree)) * std::pow(8.0, levels);
+  const double needed = kBytesPerDof * dofs / MpiSession::size();
+  const double memory =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  if (memory <= 0 || needed <= memory) return;
+  // The levels come from --levels or else from the scenario, where they may be left at their default.
+  std::string what = "--levels ";
+  if (levels == s.mesh.validation_levels)
+    what = (s.mesh.validation_levels_at.line ? s.mesh.validation_levels_at.str() : s.path) +
+           ": mesh.validation_levels" + (s.mesh.validation_levels_at.line ? " " : " (by default) ");
+  char text[600];
+  std::snprintf(
+      text, sizeof text,
+      "%d would solve level %d on %.0f hexes with about %.3g million degrees of freedom (degree %d), "
+      "which needs about %.0f GB (%.0f kB per degree of freedom%s), more than the %.0f GB of this "
+      "machine; use fewer levels, a smaller mesh.target_hexes%s, or mpirun on several machines",
+      levels, levels, static_cast<double>(coarse.hexes.size()) * std::pow(8.0, levels), dofs / 1e6,
+      s.solver.degree, needed / 1e9, kBytesPerDof / 1e3,
+      MpiSession::size() > 1 ? ", shared by the ranks" : "", memory / 1e9,
+      s.solver.degree > 1 ? " or solver.degree 1" : "");
+  throw InputError(what + text);
 }
 
 // Calls f(shape function values at the 4 corners, |x_u x x_v| times the Gauss weight) at the 2 x 2 Gauss
@@ -302,6 +344,72 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
                      std::to_string(r.mesh.hexes.size()) + "-hex mesh, so it would change nothing; " + buf);
   }
   return r;
+}
+
+// A node in the patches of two fixed supports that hold the same component gives its whole reaction to one
+// of them (solver/elasticity.cc), so the reactions of both, and the bite force when only one is a
+// bite, would depend on the order of the list (a bite patch reaching a condyle's patch took its whole
+// reaction). InputError at the later support's line.
+void require_fixed_supports_apart(const Scenario& s, const LevelResult& r) {
+  std::map<int, std::size_t> first_support;  // node -> the first fixed support whose patch holds it
+  for (std::size_t i = 0; i < s.supports.size(); ++i) {
+    const Support& later = s.supports[i];
+    if (later.spring_N_per_mm3) continue;         // a spring's reaction is its own traction
+    std::map<std::size_t, std::set<int>> shared;  // earlier support -> the nodes it shares with this one
+    for (const BoundaryQuad& face : r.support_patches[i].faces)
+      for (int v : face) {
+        const auto [it, fresh] = first_support.emplace(v, i);
+        if (fresh || it->second == i) continue;
+        const Support& earlier = s.supports[it->second];
+        for (int a = 0; a < 3; ++a)
+          if (earlier.fixed[a] && later.fixed[a]) shared[it->second].insert(v);
+      }
+    if (shared.empty()) continue;
+    const auto& [j, nodes] = *shared.begin();
+    const Support& earlier = s.supports[j];
+    std::string components;
+    for (int a = 0; a < 3; ++a)
+      if (earlier.fixed[a] && later.fixed[a])
+        components += std::string(components.empty() ? "" : ", ") + "xyz"[a];
+    throw InputError(later.where.str() + ": the patch of support '" + later.name + "' shares " +
+                     std::to_string(nodes.size()) + " nodes of the " + std::to_string(r.mesh.hexes.size()) +
+                     "-hex mesh with that of support '" + earlier.name + "' (line " +
+                     std::to_string(earlier.where.line) + "), and both fix " + components +
+                     " there: the reaction of a shared node counts for one of them only, so the reactions" +
+                     (earlier.bite != later.bite ? " and the bite force" : "") +
+                     " would depend on the order of the supports; reduce radius_mm or move a point until the "
+                     "patches are apart, or make them one support");
+  }
+}
+
+// A muscle whose insertion patch lies wholly on nodes that fixed supports hold in x, y and z pulls on
+// nothing that can move: its force goes straight into the supports' reactions (a support patch of 1000 mm
+// gave zero displacement and the muscles' total as the bite force, with exit 0). InputError at the
+// muscle's line.
+void require_muscles_load_the_bone(const Scenario& s, const LevelResult& r) {
+  std::map<int, std::array<bool, 3>> fixed;  // node -> components held by fixed supports
+  for (std::size_t i = 0; i < s.supports.size(); ++i) {
+    if (s.supports[i].spring_N_per_mm3) continue;
+    for (const BoundaryQuad& face : r.support_patches[i].faces)
+      for (int v : face)
+        for (int a = 0; a < 3; ++a) fixed[v][a] = fixed[v][a] || s.supports[i].fixed[a];
+  }
+  const auto held = [&](int v) {
+    const auto it = fixed.find(v);
+    return it != fixed.end() && it->second[0] && it->second[1] && it->second[2];
+  };
+  std::size_t patch = 0;
+  for (const Muscle& m : s.muscles) {
+    if (m.activation <= 0) continue;
+    const std::vector<BoundaryQuad>& faces = r.muscle_patches[patch++].faces;
+    if (std::all_of(faces.begin(), faces.end(),
+                    [&](const BoundaryQuad& f) { return std::all_of(f.begin(), f.end(), held); }))
+      throw InputError(
+          m.where.str() + ": the insertion patch of muscle '" + m.name +
+          "' lies wholly on nodes that the fixed supports hold in x, y and z, so its force would go "
+          "straight into their reactions and load nothing; reduce the supports' radius_mm or move "
+          "their points off the insertion");
+  }
 }
 
 // Every separate body of the mesh (hexes connected through shared nodes: the fragments of a fractured
@@ -432,7 +540,18 @@ void solve_level(const Scenario& s, LevelResult& r) {
 
   Progress progress("solve level " + std::to_string(r.level));
   const auto start = std::chrono::steady_clock::now();
-  r.solution = solve_elasticity(p);
+  try {
+    r.solution = solve_elasticity(p);
+  } catch (const RunError& e) {
+    // The solver speaks of its own options: name the level and the scenario's settings.
+    char settings[160];
+    std::snprintf(settings, sizeof settings,
+                  "; the scenario's solver.max_iterations is %d, solver.tolerance %g",
+                  s.solver.max_iterations, s.solver.tolerance);
+    throw RunError((s.solver.where.line ? s.solver.where.str() : s.path) + ": level " +
+                   std::to_string(r.level) + " (" + std::to_string(dofs) +
+                   " degrees of freedom): " + e.what() + settings);
+  }
   r.seconds_solve = seconds_since(start);
   progress.finish(std::to_string(r.solution.dofs) + " DoFs");
 }
@@ -487,6 +606,9 @@ RunResult run_pipeline(Scenario scenario, int levels) {
   result.levels.push_back(prepare_level(scenario, 0, coarse));
   result.levels.back().seconds_mesh = seconds_mesh;
   require_every_body_held(scenario, result.levels.back());  // refinement keeps the bodies
+  require_fixed_supports_apart(scenario, result.levels.back());
+  require_muscles_load_the_bone(scenario, result.levels.back());
+  require_levels_fit_memory(scenario, coarse, levels);
 
   // Every patch of every level is selected before the first solve, so a scenario error never costs a solve.
   std::unique_ptr<SurfaceProjector> projector;
@@ -504,6 +626,7 @@ RunResult run_pipeline(Scenario scenario, int levels) {
                      " inverted hexes; run with fewer validation levels (--levels) or another target_hexes");
     const double seconds = seconds_since(t);
     result.levels.push_back(prepare_level(scenario, level, std::move(fine)));
+    require_fixed_supports_apart(scenario, result.levels.back());
     result.levels.back().seconds_mesh = seconds;
     progress.finish(std::to_string(result.levels.back().mesh.hexes.size()) + " hexes");
   }

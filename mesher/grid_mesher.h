@@ -61,6 +61,11 @@ namespace hexbite {
 
 class SurfaceProjector;
 
+// The range of a wanted hex count (`hexbite mesh --target-hexes`, a scenario's mesh.target_hexes): fewer
+// than 8 hexes cannot form a grid, and above 5,000,000 the mesh and its solve outgrow a workstation.
+constexpr long kMinTargetHexes = 8;
+constexpr long kMaxTargetHexes = 5000000;
+
 struct GridMeshOptions {
   long target_hexes = 2500;
   // Cells whose centre lies at least margin * h inside the surface form the core; a negative margin takes

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "mesher/grid_mesher.h"
 #include "mesher/quad_local_refinement.h"
 #include "mesher/units.h"
 
@@ -128,8 +129,9 @@ struct Value {
   std::string path;
 };
 
+// Text by the file's word: quoted ("0.5", tag "!") or tagged as a string (!!str 0.5).
 bool is_quoted(const YAML::Node& node) {
-  return node.IsScalar() && node.Tag() == "!";
+  return node.IsScalar() && (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str");
 }
 
 std::string describe(const YAML::Node& node) {
@@ -185,12 +187,24 @@ std::vector<Value> to_list(const Value& v) {
   return items;
 }
 
+// Coordinates and vectors in mm: a mandible spans about 100 mm, so a component beyond a kilometre is a
+// typo or a wrong unit, and near the double range its squares overflow the geometric predicates.
+constexpr double kMaxCoordinateMm = 1e6;
+
 Vec3 to_vec3(const Value& v) {
   if (!v.node.IsSequence() || v.node.size() != 3)
     fail(v.at, v.path + " must be three numbers [x, y, z], found " + describe(v.node) +
                    "; write e.g. [0, -20, 45]");
+  Vec3 xyz;
   const auto items = to_list(v);
-  return {to_number(items[0]), to_number(items[1]), to_number(items[2])};
+  for (int k = 0; k < 3; ++k) {
+    xyz[k] = to_number(items[k]);
+    if (std::abs(xyz[k]) > kMaxCoordinateMm)
+      fail(items[k].at, items[k].path + " is " + fmt(xyz[k]) + ", beyond " + fmt(kMaxCoordinateMm) +
+                            " mm in size; give millimetres in the frame of the geometry (a mandible spans "
+                            "about 100 mm)");
+  }
+  return xyz;
 }
 
 PointRef to_point(const Value& v) {
@@ -398,10 +412,14 @@ MeshSettings parse_mesh(const Value& v) {
   }
   if (auto x = map.find("target_hexes")) {
     m.target_hexes = to_int(*x);
-    if (m.target_hexes <= 0) fail(x->at, "mesh.target_hexes must be positive; the default is 2500");
+    if (m.target_hexes < kMinTargetHexes || m.target_hexes > kMaxTargetHexes)
+      fail(x->at, "mesh.target_hexes is " + std::to_string(m.target_hexes) + " but must be from " +
+                      std::to_string(kMinTargetHexes) + " to " + std::to_string(kMaxTargetHexes) +
+                      "; the default is 2500, and the built-in mandible keeps its condyles from about 4000");
   }
   if (auto x = map.find("validation_levels")) {
     m.validation_levels = to_int(*x);
+    m.validation_levels_at = x->at;
     // Each level multiplies the mesh by 8: four levels of the default mesh would be ten million hexes.
     if (m.validation_levels < 0 || m.validation_levels > 3)
       fail(x->at, "mesh.validation_levels is " + std::to_string(m.validation_levels) +
@@ -437,11 +455,19 @@ MeshSettings parse_mesh(const Value& v) {
   return m;
 }
 
+// Stiffer than any material (diamond: about 1.05e6 MPa): a modulus above it is one in Pa (1.1e10 for
+// bone), which leaves the stresses right but makes the displacements a million times too small.
+constexpr double kMaxYoungsModulusMPa = 1e7;
+
 double parse_E(const Value& v) {
   const double E = to_number(v);
   if (E <= 0)
     fail(v.at, v.path + " is " + fmt(E) +
                    " MPa but Young's modulus must be positive; cortical bone is about 11000 MPa");
+  if (E > kMaxYoungsModulusMPa)
+    fail(v.at, v.path + " is " + fmt(E) +
+                   " MPa, stiffer than any material (diamond: about 1e6 MPa); give "
+                   "MPa, not Pa: cortical bone is about 11000 MPa, titanium 110000");
   return E;
 }
 
@@ -460,7 +486,10 @@ Materials parse_materials(const Value& v) {
   if (auto x = map.find("default")) {
     const Map d(*x, {"E_MPa", "poisson"});
     if (auto y = d.find("E_MPa")) m.default_material.E_MPa = parse_E(*y);
-    if (auto y = d.find("poisson")) m.default_material.poisson = parse_poisson(*y);
+    if (auto y = d.find("poisson")) {
+      m.default_material.poisson = parse_poisson(*y);
+      m.default_material.poisson_at = y->at;
+    }
   }
   if (auto x = map.find("regions")) {
     for (const Value& item : to_list(*x)) {
@@ -488,7 +517,10 @@ Materials parse_materials(const Value& v) {
                  ") changes nothing; give E_MPa and/or poisson (the one left out keeps the default)");
       region.material = m.default_material;
       if (auto y = r.find("E_MPa")) region.material.E_MPa = parse_E(*y);
-      if (auto y = r.find("poisson")) region.material.poisson = parse_poisson(*y);
+      if (auto y = r.find("poisson")) {
+        region.material.poisson = parse_poisson(*y);
+        region.material.poisson_at = y->at;
+      }
       for (const auto& earlier : m.regions)
         if (earlier.name == region.name)
           fail(item.at, "material region " + quote(region.name) + " is defined twice (first on line " +
@@ -506,6 +538,10 @@ double parse_activation(const Value& v) {
                    " but an activation must lie in [0, 1] (a fraction of the maximum force); write e.g. 0.5");
   return a;
 }
+
+// Far above any jaw muscle (all closers together give about 1 kN); a larger value is a typo or a wrong
+// unit, and a linear solve would scale it into absurd displacements and stresses.
+constexpr double kMaxMuscleForceN = 10000;
 
 Muscle default_muscle(const std::string& name, const SourceLocation& where) {
   Muscle m;
@@ -532,10 +568,16 @@ Muscle parse_muscle(const Value& item) {
     m.direction = to_vec3(*x);
     const Vec3& d = *m.direction;
     if (std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) < 1e-12)
-      fail(x->at, "muscle " + quote(m.name) +
-                      " has a zero line of action (direction [0, 0, 0]); give a non-zero direction vector");
+      fail(x->at, "muscle " + quote(m.name) + " has a zero line of action (direction " + fmt(d) +
+                      "); give a non-zero direction vector");
   }
-  if (auto x = map.find("max_force_N")) m.max_force_N = positive(*x, "the maximum force in N, e.g. 190.4");
+  if (auto x = map.find("max_force_N")) {
+    m.max_force_N = positive(*x, "the maximum force in N, e.g. 190.4");
+    if (*m.max_force_N > kMaxMuscleForceN)
+      fail(x->at, x->path + " is " + fmt(*m.max_force_N) + " N, more than " + fmt(kMaxMuscleForceN) +
+                      " N; no jaw muscle comes near (the superficial masseter gives about 190 N): give the "
+                      "force in newtons");
+  }
   m.activation =
       parse_activation(map.require("activation", "activation: 0.5 (a fraction of max_force_N in [0, 1])"));
   return m;
@@ -616,6 +658,7 @@ Support parse_support(const Value& item) {
 SolverSpec parse_solver(const Value& v) {
   const Map map(v, {"degree", "linear_solver", "tolerance", "max_iterations"});
   SolverSpec s;
+  s.where = v.at;
   if (auto x = map.find("degree")) {
     s.degree = to_int(*x);
     if (s.degree != 1 && s.degree != 2)
@@ -655,6 +698,26 @@ void check_unique_names(const std::vector<T>& items, const std::string& kind) {
         fail(items[i].where, kind + " " + quote(items[i].name) + " is defined twice (first on line " +
                                  std::to_string(items[j].where.line) + "); give each " + kind +
                                  " its own name");
+}
+
+// Linear (Q1) hexes lock as the material nears incompressibility: on the built-in mandible (4,025 hexes)
+// their largest displacement is 0.89 of the Q2 value at poisson 0.28, 0.84 at 0.45, 0.70 at 0.49, 0.37 at
+// 0.499 and 0.11 at 0.4999 (von Mises maximum 0.61, 0.60, 0.53, and 0.07 at 0.4999). Above 0.45 they are
+// refused.
+constexpr double kMaxPoissonQ1 = 0.45;
+
+void check_poisson_for_degree(const Scenario& s) {
+  if (s.solver.degree != 1) return;
+  std::vector<const MaterialSpec*> materials = {&s.materials.default_material};
+  for (const MaterialRegion& region : s.materials.regions) materials.push_back(&region.material);
+  for (const MaterialSpec* m : materials)
+    if (m->poisson > kMaxPoissonQ1)
+      fail(m->poisson_at,
+           "poisson " + fmt(m->poisson) + " with solver.degree 1: linear hexes lock when the material is " +
+               "nearly incompressible (volumetric locking: on the built-in mandible their displacement is "
+               "0.89 " +
+               "of the Q2 value at 0.28, 0.70 at 0.49 and 0.11 at 0.4999); write solver: {degree: 2} for a " +
+               "Poisson's ratio above " + fmt(kMaxPoissonQ1) + ", or use at most " + fmt(kMaxPoissonQ1));
 }
 
 // Checks that can be made before the geometry exists: something loads the bone, something holds it.
@@ -726,6 +789,7 @@ Scenario parse_scenario(const Ctx& ctx, const YAML::Node& root_node) {
       s.probes.push_back({to_string(p.require("name", "name: chin")),
                           to_point(p.require("at", "at: incisal_point")), item.at});
     }
+  check_poisson_for_degree(s);
   check_unique_names(s.muscles, "muscle");
   check_unique_names(s.supports, "support");
   check_unique_names(s.probes, "probe");
@@ -758,14 +822,21 @@ Scenario load_scenario(const std::string& path) {
     throw InputError("cannot read scenario file '" + path + "'; check the path (scenarios are YAML files)");
   std::stringstream text;
   text << in.rdbuf();
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(text.str());
+    documents = YAML::LoadAll(text.str());
   } catch (const YAML::Exception& e) {
     const SourceLocation where{path, e.mark.line + 1, e.mark.column + 1};
     fail(where,
          "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets near this place");
   }
+  // Two scenarios pasted into one file: the second would be ignored without a word.
+  for (size_t i = 1; i < documents.size(); ++i)
+    if (!documents[i].IsNull())
+      fail({path, documents[i].Mark().line + 1, 1},
+           "a second YAML document starts here (after a '---' line); a scenario file holds one scenario: "
+           "put each scenario in its own file");
+  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
   const Ctx ctx{path, fs::path(path).parent_path()};
   if (!root.IsDefined() || root.IsNull())
     fail({path, 1, 1},

@@ -65,8 +65,9 @@ enum class MeshMethod { kGrid, kSheets };
 struct MeshSettings {
   MeshMethod method = MeshMethod::kGrid;
   int target_hexes = 2500;
-  int validation_levels = 1;  // each level is one 8-way refinement solved again
-  SourceLocation method_at;   // where `method` was written (empty when it was left at its default)
+  int validation_levels = 1;            // each level is one 8-way refinement solved again
+  SourceLocation method_at;             // where `method` was written (empty when it was left at its default)
+  SourceLocation validation_levels_at;  // where `validation_levels` was written (empty: the default)
   // method sheets only: refine the quad surface around every bite support's point
   // (mesher/quad_local_refinement.h), with this patch radius and number of rings.
   bool refine_at_bite = false;
@@ -81,6 +82,7 @@ struct MeshSettings {
 struct MaterialSpec {
   double E_MPa = 11000;
   double poisson = 0.28;
+  SourceLocation poisson_at;  // where `poisson` was written (empty: the default)
 };
 
 enum class RegionShape { kSphere, kBox };
@@ -131,6 +133,7 @@ struct SolverSpec {
   LinearSolverChoice linear_solver = LinearSolverChoice::kAuto;
   double tolerance = 1e-10;  // relative residual
   int max_iterations = 10000;
+  SourceLocation where;  // where the `solver` mapping was written (empty: all defaults)
 };
 
 struct Outputs {

@@ -564,6 +564,90 @@ muscles:
   EXPECT_NE(err.find(landmarks), std::string::npos) << err;
 }
 
+// A run into the folder of an earlier run with more levels, --export inp or more ranks left that run's
+// solution_level1.vtu, model.inp and pieces beside the new files, as if they belonged to them.
+TEST(RunScenario, FilesOfAnEarlierRunThatThisRunDoesNotWriteAreRemoved) {
+  const std::string dir = test::temp_dir();
+  const std::string out = dir + "/out";
+  fs::create_directories(out);
+  const std::vector<std::string> stale = {
+      "solution_level1.vtu", "solution_level2.pvtu", "solution_level2_1.vtu", "solution_1.vtu",
+      "model.inp",           "model_mesh.inp"};
+  for (const std::string& name : stale) test::write_file(out + "/" + name, "old\n");
+  test::write_file(out + "/notes.txt", "mine\n");
+  test::write_file(dir + "/small.yaml", kSmall);
+  ASSERT_TRUE(run_scenario(dir + "/small.yaml", out).is_object());
+  for (const std::string& name : stale) EXPECT_FALSE(fs::exists(out + "/" + name)) << name;
+  for (const char* name : {"notes.txt", "results.json", "mesh.vtu", "solution.vtu"})
+    EXPECT_TRUE(fs::exists(out + "/" + name)) << name;
+}
+
+// E_MPa: 1e-6 (a unit slip) gave displacements of 1e15 mm with exit 0: linear elasticity holds only for
+// small displacements, so the run fails like an unbalanced one, its files kept for inspection.
+TEST(RunScenario, DisplacementsLargeAgainstTheBoneFailTheRun) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/soft.yaml", kSmall + "materials:\n  default: {E_MPa: 1.0e-6}\n");
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/soft.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("level 0: the largest displacement"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("check materials E_MPa"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/out/results.json"));
+}
+
+// Three validation levels of a Q2 problem of 4,000 hexes are about 56 million DoFs, some 280 GB: such a run
+// used to refine for minutes and end in bad_alloc or the kernel's out-of-memory kill.
+TEST(RunScenario, ValidationLevelsBeyondTheMachinesMemoryAreRefused) {
+  std::string text = kSmall + "solver: {degree: 2}\n";
+  text.replace(text.find("validation_levels: 0"), 20, "validation_levels: 3");
+  const std::string err =
+      expect_refused(text, "mesh.validation_levels 3 would solve level 3 on 2060800 hexes");
+  EXPECT_NE(err.find("bad.yaml:4:"), std::string::npos) << err;
+  EXPECT_NE(err.find("more than the"), std::string::npos) << err;
+}
+
+// A node on two fixed supports gives its whole reaction to the first one: a bite patch reaching a condyle's
+// patch reported the condyle's reaction as the bite force (342 N, the condyle 0 N) with exit 0.
+TEST(RunScenario, FixedSupportsSharingNodesAreRefused) {
+  std::string text = kSmall;
+  text.replace(text.find("at: right_first_molar_bite_point"), 32, "at: right_condyle_tmj_point");
+  const std::string err = expect_refused(text, "the patch of support 'right_condyle' shares");
+  EXPECT_NE(err.find("bad.yaml:9:"), std::string::npos) << err;  // the later of the two
+  EXPECT_NE(err.find("with that of support 'nut' (line 8), and both fix x, y, z"), std::string::npos) << err;
+  EXPECT_NE(err.find("the reactions and the bite force would depend on the order"), std::string::npos) << err;
+}
+
+// The message began with the mesher's name of the surface ("'the built-in mandible': bad.yaml:8:...").
+TEST(RunScenario, RefineAtBiteOnAPointOffTheBoneIsRefusedAtTheSupportsLine) {
+  std::string text = kSmall;
+  text.replace(text.find("target_hexes"), 0, "method: sheets, refine_at_bite: true, ");
+  text.replace(text.find("at: right_first_molar_bite_point"), 32, "at: [0, 0, -200]");
+  const std::string err = expect_refused(text, "the bite support nut's point (mesh.refine_at_bite) is");
+  EXPECT_NE(err.find("bad.yaml:8:"), std::string::npos) << err;        // the line of the support
+  EXPECT_EQ(err.find("hexbite: error: '"), std::string::npos) << err;  // the file comes first
+}
+
+// CG out of iterations said "raise max_iterations" without the scenario's line, level or setting.
+TEST(RunScenario, SolverOutOfIterationsNamesTheScenariosSettings) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/few.yaml", kSmall + "solver: {linear_solver: cg_amg, max_iterations: 2}\n");
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/few.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/few.yaml:11:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("level 0 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("CG did not converge in 2 iterations"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the scenario's solver.max_iterations is 2"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
+// One fixed support over the whole bone: zero displacement and the muscles' total as the bite force, exit 0.
+TEST(RunScenario, MuscleWhollyOnFixedNodesIsRefused) {
+  std::string text = kSmall.substr(0, kSmall.find("supports:"));
+  text += "supports:\n  - {name: all, at: incisal_point, radius_mm: 1000, bite: true}\n";
+  const std::string err =
+      expect_refused(text, "the insertion patch of muscle 'left_superficial_masseter' lies wholly on nodes");
+  EXPECT_NE(err.find("bad.yaml:6:"), std::string::npos) << err;  // the activation_pattern entry
+}
+
 TEST(RunScenario, SpringSupportIsRefusedForTheCalculixExport) {
   std::string text = kSmall;
   text.replace(text.find("radius_mm: 6}"), 13, "radius_mm: 6, spring_N_per_mm3: 50}");

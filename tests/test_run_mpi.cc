@@ -13,6 +13,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "mesher/hex_mesh_io.h"
 #include "tests/test_util.h"
@@ -40,6 +41,47 @@ void expect_same(const json& a, const json& b, const std::string& what) {
     const std::string key = a.is_object() ? it.key() : std::to_string(it - a.begin());
     expect_same(*it, a.is_object() ? b.at(it.key()) : b.at(it - a.begin()), what + "." + key);
   }
+}
+
+const std::vector<std::string> kTwoRanks = {HEXBITE_MPIEXEC, "-np", "2", "--allow-run-as-root",
+                                            "--oversubscribe"};
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// A bad scenario stops every rank with the same message: it used to be printed by each rank.
+TEST(RunMpi, AScenarioErrorIsReportedOnce) {
+  const std::string dir = test::temp_dir();
+  std::string text =
+      test::read_file(std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml");
+  text.replace(text.find("E_MPa: 11000"), 12, "E_MPa: 0");
+  test::write_file(dir + "/bad.yaml", text);
+  const test::CommandResult r =
+      test::run_hexbite({"-q", "run", dir + "/bad.yaml", "-o", dir + "/out"}, kTwoRanks);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(count(r.err, "hexbite: error: " + dir + "/bad.yaml:"), 1u) << r.err;
+  EXPECT_EQ(count(r.err, "[rank"), 0u) << r.err;
+  // A command-line error, the same on every rank, too.
+  const test::CommandResult no_output = test::run_hexbite({"-q", "run", dir + "/bad.yaml"}, kTwoRanks);
+  EXPECT_EQ(no_output.exit_code, 2) << no_output.err;
+  EXPECT_EQ(count(no_output.err, "--output is required"), 1u) << no_output.err;
+}
+
+// An error of rank 0 alone (its output folder cannot be made) left rank 1 waiting in a barrier, and the job
+// hung: the failing rank now aborts the job.
+TEST(RunMpi, AnErrorOfOneRankEndsTheJob) {
+  std::vector<std::string> launcher = kTwoRanks;
+  launcher.insert(launcher.begin(), {"timeout", "300"});
+  const test::CommandResult r = test::run_hexbite(
+      {"-q", "run", std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml", "-o",
+       "/proc/no/such/folder", "--levels", "0"},
+      launcher);
+  EXPECT_EQ(r.exit_code, 1) << r.err;  // timeout's 124 when the job hangs
+  EXPECT_NE(r.err.find("[rank 0] hexbite: failed: cannot create the output folder"), std::string::npos)
+      << r.err;
 }
 
 TEST(RunMpi, TwoRanksGiveTheSerialFigures) {

@@ -308,6 +308,8 @@ TEST(ScenarioErrors, IllTypedFields) {
                   "muscles[0].activation must be a number, found 'high'");
   EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: \"0.5\"")), 6,
                   "must be a number, found the quoted text \"0.5\"");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: !!str 0.5")), 6,
+                  "must be a number, found the quoted text \"0.5\"");
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 2.5}\n"), 11,
                   "mesh.target_hexes must be a whole number");
   EXPECT_ERROR_AT(error_of(kValid + "outputs: {vtu: maybe}\n"), 11, "outputs.vtu must be true or false");
@@ -324,6 +326,9 @@ TEST(ScenarioErrors, YoungsModulusMustBePositive) {
   EXPECT_ERROR_AT(error_of(kValid + "materials:\n  regions:\n    - {name: r, sphere: {center: [0, 0, 0], "
                                     "radius_mm: 2}, E_MPa: -5}\n"),
                   13, "materials.regions[0].E_MPa is -5 MPa");
+  // A modulus in Pa left the stresses right and made the displacements a million times too small.
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 1.1e10}\n"), 12,
+                  "materials.default.E_MPa is 1.1e+10 MPa, stiffer than any material");
 }
 
 TEST(ScenarioErrors, PoissonOutsideItsRange) {
@@ -331,6 +336,18 @@ TEST(ScenarioErrors, PoissonOutsideItsRange) {
                   "Poisson's ratio must lie strictly between -1 and 0.5");
   EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: -1}\n"), 12,
                   "materials.default.poisson is -1");
+}
+
+// poisson 0.4999 with Q1 gave a tenth of the displacement (volumetric locking) with exit 0.
+TEST(ScenarioErrors, NearlyIncompressibleMaterialNeedsDegreeTwo) {
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: 0.4999}\n"), 12,
+                  "poisson 0.4999 with solver.degree 1: linear hexes lock");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  regions:\n    - {name: pdl, sphere: {center: [0, 0, 0], "
+                                    "radius_mm: 2}, poisson: 0.49}\n"),
+                  13, "write solver: {degree: 2} for a Poisson's ratio above 0.45");
+  EXPECT_NO_THROW(load_scenario(write_scenario(kValid + "materials:\n  default: {poisson: 0.45}\n")));
+  EXPECT_NO_THROW(load_scenario(
+      write_scenario(kValid + "materials:\n  default: {poisson: 0.49}\nsolver: {degree: 2}\n")));
 }
 
 TEST(ScenarioErrors, ActivationOutsideZeroOne) {
@@ -350,10 +367,37 @@ TEST(ScenarioErrors, NegativeRadiusOrForce) {
                   "supports[0].radius_mm is -4");
 }
 
+TEST(ScenarioErrors, ImplausibleForceTargetOrCoordinates) {
+  // 1e30 N gave absurd figures with exit 0 and 1e300 N a "not finite" failure blaming the supports.
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    max_force_N: 1e30")), 7,
+      "muscles[0].max_force_N is 1e+30 N, more than 10000 N");
+  // 1 reached the grid mesher, whose message had no scenario line; 2e9 ran out of memory.
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 1}\n"), 11,
+                  "mesh.target_hexes is 1 but must be from 8 to 5000000");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 2000000000}\n"), 11,
+                  "mesh.target_hexes is 2000000000");
+  // A probe at 1e308 mm crashed the run (SIGFPE in the exact predicates); a direction of 1e200 mm
+  // normalized to zero, so the muscle pulled with no force.
+  EXPECT_ERROR_AT(error_of(kValid + "probes:\n  - {name: far, at: [1e308, 0, 0]}\n"), 12,
+                  "probes[0].at[0] is 1e+308, beyond 1e+06 mm");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    direction: [0, 1e200, 0]")),
+      7, "muscles[0].direction[1] is 1e+200");
+}
+
+TEST(ScenarioErrors, ASecondYamlDocumentIsRefused) {
+  EXPECT_ERROR_AT(error_of(kValid + "---\nname: other\n"), 12, "a second YAML document starts here");
+  EXPECT_NO_THROW(load_scenario(write_scenario(kValid + "---\n")));  // an empty one changes nothing
+}
+
 TEST(ScenarioErrors, ZeroLineOfAction) {
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    direction: [0, 0, 0]")), 7,
       "muscle 'right_superficial_masseter' has a zero line of action");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    direction: [0, 0, 1e-13]")),
+      7, "has a zero line of action (direction [0, 0, 1e-13])");
   // Only known once the names are resolved: the origin is the insertion's own landmark.
   EXPECT_ERROR_AT(error_of(replace(kValid, "    activation: 0.5",
                                    "    activation: 0.5\n    origin: right_superficial_masseter.insertion"),

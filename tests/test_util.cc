@@ -60,10 +60,12 @@ std::string temp_dir() {
   return dir.string();
 }
 
-CommandResult run_hexbite(const std::vector<std::string>& args) {
+CommandResult run_hexbite(const std::vector<std::string>& args, const std::vector<std::string>& launcher) {
   const std::string dir = temp_dir();
   const std::string out_file = dir + "/stdout", err_file = dir + "/stderr";
-  std::string cmd = shell_quote(HEXBITE_EXE);
+  std::string cmd;
+  for (const auto& a : launcher) cmd += shell_quote(a) + " ";
+  cmd += shell_quote(HEXBITE_EXE);
   for (const auto& a : args) cmd += " " + shell_quote(a);
   cmd += " >" + shell_quote(out_file) + " 2>" + shell_quote(err_file) + " </dev/null";
   const int status = std::system(cmd.c_str());

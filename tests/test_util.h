@@ -12,8 +12,10 @@ struct CommandResult {
   std::string err;  // stderr
 };
 
-// Runs the built hexbite program with the given arguments (no shell quoting needed).
-CommandResult run_hexbite(const std::vector<std::string>& args);
+// Runs the built hexbite program with the given arguments (no shell quoting needed), behind `launcher`
+// (e.g. mpirun -np 2) when one is given.
+CommandResult run_hexbite(const std::vector<std::string>& args,
+                          const std::vector<std::string>& launcher = {});
 
 // A fresh, empty temporary folder per call, removed at process exit.
 std::string temp_dir();
