@@ -1,6 +1,8 @@
 // Helpers shared by the test suites: running the hexbite program, temporary folders, shared data.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <string>
 #include <vector>
 
@@ -26,5 +28,17 @@ std::string shared_data(const std::string& relative);
 // Reads or writes a whole file.
 std::string read_file(const std::string& path);
 void write_file(const std::string& path, const std::string& contents);
+
+// The message of the exception of type E that f() throws; a test failure, and "", when it throws none.
+template <class E, class F>
+std::string message_of(F f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an exception";
+  return "";
+}
 
 }  // namespace hexbite::test
