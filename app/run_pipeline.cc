@@ -157,14 +157,9 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
   try {
     mesh = mesh_mandible_by_sheets(geometry.surface, has_landmarks ? &geometry.landmarks : nullptr, options,
                                    &report);
+  } catch (const LocalRefinementError&) {
+    throw;  // a bite point off the bone: the message starts with the support's line (point_names above)
   } catch (const InputError& e) {
-    // A bite point off the bone: the message names the support's line and the key, after the mesher's
-    // name of the surface, which goes, so that the line comes first as in every scenario error.
-    const std::string what = e.what();
-    for (const Support& support : s.supports) {
-      const std::size_t at = what.find(support.at.where.str() + ": the bite support");
-      if (at != std::string::npos) throw InputError(what.substr(at));
-    }
     throw InputError(
         s.mesh.method_at.str() + ": mesh.method 'sheets' cannot place its mandible template: " + e.what() +
         "; give landmarks with the template's points, or use method: grid for a bone that is not a "

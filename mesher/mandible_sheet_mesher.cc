@@ -60,12 +60,12 @@ QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* l
   QuadSurface quads;
   try {
     quads = quad_surface_from_mandible(surface, landmarks, landmark_file, options, report);
-    if (refinement.enabled())
-      quads = refine_quads_locally(quads, SurfaceProjector(surface), report->landmark_vertices, refinement,
-                                   refinement_report);
   } catch (const InputError& e) {
     throw InputError("'" + surface_name + "': " + e.what());
   }
+  if (refinement.enabled())
+    quads = refine_quads_locally(quads, SurfaceProjector(surface), report->landmark_vertices, refinement,
+                                 refinement_report);
   *check = check_quad_surface(quads, surface_name + " (quad surface)");
   if (!check->usable()) {
     std::string problems;

@@ -215,11 +215,11 @@ QuadSurface refine_quads_locally(const QuadSurface& quads, const SurfaceProjecto
     return quads;
   }
   if (!(o.radius_mm >= kMinRefineRadiusMm && o.radius_mm <= kMaxRefineRadiusMm))
-    throw InputError("the local refinement radius " + mm(o.radius_mm) + " is out of range: give " +
-                     mm(kMinRefineRadiusMm) + " to " + mm(kMaxRefineRadiusMm));
+    throw LocalRefinementError("the local refinement radius " + mm(o.radius_mm) + " is out of range: give " +
+                               mm(kMinRefineRadiusMm) + " to " + mm(kMaxRefineRadiusMm));
   if (o.levels < 1 || o.levels > kMaxRefineLevels)
-    throw InputError("the local refinement levels " + std::to_string(o.levels) +
-                     " are out of range: give 1 to " + std::to_string(kMaxRefineLevels));
+    throw LocalRefinementError("the local refinement levels " + std::to_string(o.levels) +
+                               " are out of range: give 1 to " + std::to_string(kMaxRefineLevels));
 
   // Step 1. Seeds and the patch grown by breadth-first search over quads within the radius.
   QuadSurface s = quads;
@@ -231,9 +231,10 @@ QuadSurface refine_quads_locally(const QuadSurface& quads, const SurfaceProjecto
     const SurfacePoint on = surface.closest(o.points[i]);
     const std::string name = i < o.point_names.size() ? o.point_names[i] : "the refinement point";
     if (on.distance > o.max_point_distance_mm)
-      throw InputError(name + " is " + mm(on.distance) + " from the surface (nearest surface point " +
-                       point_text(on.point) + "); at most " + mm(o.max_point_distance_mm) +
-                       " is allowed: give a point on the bone surface, such as a bite-point landmark");
+      throw LocalRefinementError(
+          name + " is " + mm(on.distance) + " from the surface (nearest surface point " +
+          point_text(on.point) + "); at most " + mm(o.max_point_distance_mm) +
+          " is allowed: give a point on the bone surface, such as a bite-point landmark");
     LocalRefinementSite site;
     site.point = o.points[i];
     site.on_surface = on.point;
@@ -256,8 +257,8 @@ QuadSurface refine_quads_locally(const QuadSurface& quads, const SurfaceProjecto
     }
   }
   if (!grow_to_disks(s, qe, in))
-    throw InputError("the local refinement patches (radius " + mm(o.radius_mm) +
-                     ") cover the whole surface: give a smaller radius");
+    throw LocalRefinementError("the local refinement patches (radius " + mm(o.radius_mm) +
+                               ") cover the whole surface: give a smaller radius");
   std::vector<int> component;
   report.patches = quad_components(
       qe, [&](int q) { return in[q] != 0; }, [](int) { return true; }, component);

@@ -31,8 +31,9 @@
 //      fixed.
 // Hand-written: pillowing a disk of a quad surface is a few lines over our own QuadSurface (no library we
 // use offers it), and the relaxation needs the restricted projection on the input triangles.
-// Failure: InputError when a point is farther than max_point_distance_mm from the surface (naming it by
-// point_names), the radius or the levels are out of range, or the patches would cover the whole surface.
+// Failure: LocalRefinementError (an InputError) when a point is farther than max_point_distance_mm from the
+// surface (naming it by point_names), the radius or the levels are out of range, or the patches would cover
+// the whole surface.
 // Cost: O(Q) for the patch and the pillowing (Q quads), plus up to 3 relax_sweeps closest-point queries
 // per moved vertex (O(log T) each for T triangles); 8 to 18 ms for one bite point on the mandibles
 // (docs/mandible_quads.md, "Local refinement around the bite point").
@@ -43,10 +44,18 @@
 #include <string>
 #include <vector>
 
+#include "common/error.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/surface_projector.h"
 
 namespace hexbite {
+
+// The input errors of refine_quads_locally(). Their message names the point (point_names), radius or levels
+// at fault, so callers pass them on as they are instead of as a failure of what they refine.
+class LocalRefinementError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 // Ranges of the radius and the levels (the CLI and the scenario reader check them with their own names).
 inline constexpr double kMinRefineRadiusMm = 1.0;
