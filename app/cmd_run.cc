@@ -7,11 +7,14 @@
 // kEquilibriumTolerance the run fails (exit 1), so a wrong answer never passes silently but stays
 // inspectable. Under mpirun every rank runs this command; rank 0 prints and writes (docs/running.md).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "app/commands.h"
 #include "app/option_checks.h"
@@ -40,7 +43,7 @@ constexpr double kMaxDisplacementFraction = 0.1;
 struct RunCliOptions {
   std::string scenario;
   std::string output;
-  std::string export_format;
+  std::vector<std::string> export_formats;  // --export, repeats allowed
   std::optional<int> levels;
   bool json = false;
 };
@@ -49,7 +52,8 @@ void run_run(const RunCliOptions& o) {
   const bool root = MpiSession::rank() == 0;
   Scenario scenario = load_scenario(o.scenario);
   const int levels = o.levels ? *o.levels : scenario.mesh.validation_levels;
-  const bool export_inp = o.export_format == "inp" || scenario.outputs.inp;
+  const bool export_inp =
+      std::count(o.export_formats.begin(), o.export_formats.end(), "inp") > 0 || scenario.outputs.inp;
   if (export_inp) check_inp_exportable(scenario);
 
   const RunResult result = run_pipeline(std::move(scenario), levels);
@@ -104,7 +108,12 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output folder (created if missing)")
       ->required()
       ->check(output_folder());
-  cmd->add_option("--export", o->export_format, "Also write the model for another solver: inp (CalculiX)")
+  // A set of formats: a repeated --export (a script adding it to a command line that has it) is no error.
+  cmd->add_option("--export", o->export_formats,
+                  "Also write the model for another solver: inp (CalculiX); may be repeated")
+      ->expected(1)
+      ->allow_extra_args(false)  // one format per --export: `--export inp SCENARIO` is not two formats
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->check(CLI::IsMember({"inp"}));
   cmd->add_option(
          "--levels", o->levels,

@@ -13,6 +13,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/number_format.h"
 #include "mesher/hex_mesh_io.h"
 #include "postprocess/quality_json.h"
 #include "solver/mpi_session.h"
@@ -403,6 +404,13 @@ std::string summary_table(const RunResult& r) {
     }
     out << '\n';
   };
+  // Figures in fixed point, but never a small one shown as zero (format_table_number).
+  const auto figure_row = [&](const char* label, int decimals, auto value) {
+    std::snprintf(line, sizeof line, "%-28s", label);
+    out << line;
+    for (const LevelResult& l : r.levels) out << format_table_number(value(l), decimals, 14);
+    out << '\n';
+  };
   std::snprintf(line, sizeof line, "%-28s", "level");
   out << line;
   for (const LevelResult& l : r.levels) {
@@ -413,18 +421,18 @@ std::string summary_table(const RunResult& r) {
   row("hexes", "%14zu", [](const LevelResult& l) { return l.mesh.hexes.size(); });
   row("degrees of freedom", "%14lld", [](const LevelResult& l) { return l.solution.dofs; });
   if (r.scenario.outputs.bite_force)
-    row("bite force (N)", "%14.2f", [](const LevelResult& l) { return l.solution.bite_force; });
+    figure_row("bite force (N)", 2, [](const LevelResult& l) { return l.solution.bite_force; });
   for (std::size_t i = 0; i < r.scenario.supports.size(); ++i) {
     const std::string label = "reaction " + r.scenario.supports[i].name + " (N)";
-    row(label.c_str(), "%14.2f", [i](const LevelResult& l) { return l.solution.reactions[i].magnitude; });
+    figure_row(label.c_str(), 2, [i](const LevelResult& l) { return l.solution.reactions[i].magnitude; });
   }
-  row("max displacement (mm)", "%14.5f", [](const LevelResult& l) { return l.solution.max_displacement; });
-  row("von Mises max (MPa)", "%14.3f", [](const LevelResult& l) { return l.solution.von_mises_max; });
-  row("von Mises p99 (MPa)", "%14.3f", [](const LevelResult& l) { return l.solution.von_mises_p99; });
-  row("strain energy (mJ)", "%14.5f", [](const LevelResult& l) { return l.solution.strain_energy; });
+  figure_row("max displacement (mm)", 5, [](const LevelResult& l) { return l.solution.max_displacement; });
+  figure_row("von Mises max (MPa)", 3, [](const LevelResult& l) { return l.solution.von_mises_max; });
+  figure_row("von Mises p99 (MPa)", 3, [](const LevelResult& l) { return l.solution.von_mises_p99; });
+  figure_row("strain energy (mJ)", 5, [](const LevelResult& l) { return l.solution.strain_energy; });
   row("equilibrium residual", "%14.2e", [](const LevelResult& l) { return l.solution.equilibrium_residual; });
   row("CG iterations (0 = direct)", "%14d", [](const LevelResult& l) { return l.solution.iterations; });
-  row("solve seconds", "%14.2f", [](const LevelResult& l) { return l.solution.seconds; });
+  figure_row("solve seconds", 2, [](const LevelResult& l) { return l.solution.seconds; });
   if (r.levels.size() >= 2) {
     const int last = r.levels.back().level;
     out << "relative change, level " << last << " against " << last - 1 << ": bite force ";

@@ -11,10 +11,9 @@
 #include <set>
 #include <string>
 
-#include <unistd.h>
-
 #include "common/error.h"
 #include "common/progress.h"
+#include "common/system_memory.h"
 #include "mesher/boundary_fit.h"
 #include "mesher/ct_surface.h"
 #include "mesher/grid_mesher.h"
@@ -222,30 +221,29 @@ long long count_dofs(const HexMesh& mesh, int degree) {
 constexpr double kBytesPerDof = 5e3;
 
 // Each validation level multiplies the problem by 8 (a Q2 problem of the shipped 4,000 hexes has 7 million
-// DoFs at level 2): a last level whose solve needs more than this machine's memory, even shared by all
-// ranks, is refused before the refinement, instead of ending minutes later in bad_alloc or the kernel's
-// out-of-memory kill.
+// DoFs at level 2): a last level whose solve needs more than this machine's memory (or the container's
+// cgroup limit, when lower), even shared by all ranks, is refused before the refinement, instead of ending
+// minutes later in bad_alloc or the kernel's out-of-memory kill.
 void require_levels_fit_memory(const Scenario& s, const HexMesh& coarse, int levels) {
   if (levels == 0) return;
   const double dofs = static_cast<double>(count_dofs(coarse, s.solver.degree)) * std::pow(8.0, levels);
   const double needed = kBytesPerDof * dofs / MpiSession::size();
-  const double memory =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
-  if (memory <= 0 || needed <= memory) return;
+  const MemoryLimit memory = machine_memory();
+  if (memory.bytes <= 0 || needed <= memory.bytes) return;
   // The levels come from --levels or else from the scenario, where they may be left at their default.
   std::string what = "--levels ";
   if (levels == s.mesh.validation_levels)
     what = (s.mesh.validation_levels_at.line ? s.mesh.validation_levels_at.str() : s.path) +
            ": mesh.validation_levels" + (s.mesh.validation_levels_at.line ? " " : " (by default) ");
-  char text[600];
+  char text[800];
   std::snprintf(
       text, sizeof text,
       "%d would solve level %d on %.0f hexes with about %.3g million degrees of freedom (degree %d), "
-      "which needs about %.0f GB (%.0f kB per degree of freedom%s), more than the %.0f GB of this "
-      "machine; use fewer levels, a smaller mesh.target_hexes%s, or mpirun on several machines",
+      "which needs about %.3g GB (%.0f kB per degree of freedom%s), more than the %.3g GB of %s; use fewer "
+      "levels, a smaller mesh.target_hexes%s, or mpirun on several machines",
       levels, levels, static_cast<double>(coarse.hexes.size()) * std::pow(8.0, levels), dofs / 1e6,
       s.solver.degree, needed / 1e9, kBytesPerDof / 1e3,
-      MpiSession::size() > 1 ? ", shared by the ranks" : "", memory / 1e9,
+      MpiSession::size() > 1 ? ", shared by the ranks" : "", memory.bytes / 1e9, memory.source.c_str(),
       s.solver.degree > 1 ? " or solver.degree 1" : "");
   throw InputError(what + text);
 }

@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "mesher/surface_projector.h"
+#include "mesher/units.h"
 
 namespace hexbite {
 
@@ -33,11 +34,29 @@ double read_number(const std::string& path, const YAML::Node& node, const std::s
   return value;
 }
 
+std::string format_general(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// A point in mm, each coordinate within kMaxCoordinateMm like a scenario's own (scenarios/scenario.cc), also
+// after the conversion from the file's unit.
 Vec3 read_point(const std::string& path, const YAML::Node& node, const std::string& what, double scale) {
   if (!node.IsSequence() || node.size() != 3)
     fail(path, node.Mark(), what + " must be a list of three coordinates [x, y, z]");
   Vec3 p{};
-  for (std::size_t k = 0; k < 3; ++k) p[k] = scale * read_number(path, node[k], what + " coordinate");
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double value = read_number(path, node[k], what + " coordinate");
+    p[k] = scale * value;
+    if (!(std::abs(p[k]) <= kMaxCoordinateMm))
+      fail(path, node[k].Mark(),
+           what + " coordinate is " + format_general(p[k]) +
+               (scale == 1.0 ? "" : " mm (" + format_general(value) + " in the file's unit)") + ", beyond " +
+               format_general(kMaxCoordinateMm) +
+               " mm in size; give the coordinates in the frame and unit of the surface (a mandible spans "
+               "about 100 mm)");
+  }
   return p;
 }
 
@@ -46,6 +65,10 @@ void read_muscle(const std::string& path, const YAML::Node& node, double scale, 
   if (!node.IsMap())
     fail(path, node.Mark(), "each muscle must be a map {name, max_force_N, insertion, origin}");
   MuscleLine m;
+  // The name may follow the points in the map; the messages about them give it.
+  const YAML::Node name = node["name"];
+  const std::string muscle =
+      name && name.IsScalar() && !name.Scalar().empty() ? "muscle '" + name.Scalar() + "' " : "muscle ";
   bool has[4] = {false, false, false, false};
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
@@ -55,14 +78,20 @@ void read_muscle(const std::string& path, const YAML::Node& node, double scale, 
       m.name = kv.second.Scalar();
       has[0] = true;
     } else if (key == "max_force_N") {
-      m.max_force_N = read_number(path, kv.second, "max_force_N");
-      if (m.max_force_N < 0) fail(path, kv.second.Mark(), "max_force_N must not be negative");
+      m.max_force_N = read_number(path, kv.second, muscle + "max_force_N");
+      if (m.max_force_N < 0) fail(path, kv.second.Mark(), muscle + "max_force_N must not be negative");
+      if (m.max_force_N > kMaxMuscleForceN)
+        fail(path, kv.second.Mark(),
+             muscle + "max_force_N is " + format_general(m.max_force_N) + " N, more than " +
+                 format_general(kMaxMuscleForceN) +
+                 " N; no jaw muscle comes near (the superficial masseter gives about 190 N): give the force "
+                 "in newtons");
       has[1] = true;
     } else if (key == "insertion") {
-      m.insertion = read_point(path, kv.second, "insertion", scale);
+      m.insertion = read_point(path, kv.second, muscle + "insertion", scale);
       has[2] = true;
     } else if (key == "origin") {
-      m.origin = read_point(path, kv.second, "origin", scale);
+      m.origin = read_point(path, kv.second, muscle + "origin", scale);
       has[3] = true;
     } else {
       fail(path, kv.first.Mark(),

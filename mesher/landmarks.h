@@ -11,6 +11,11 @@
 
 namespace hexbite {
 
+// The largest muscle force accepted from a scenario or landmark file, in N: far above any jaw muscle (all
+// closers together give about 1 kN); a larger value is a typo or a wrong unit, and a linear solve would scale
+// it into absurd displacements and stresses.
+constexpr double kMaxMuscleForceN = 10000;
+
 struct MuscleLine {
   std::string name;  // e.g. left_superficial_masseter
   double max_force_N = 0;

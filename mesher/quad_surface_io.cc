@@ -122,7 +122,8 @@ QuadSurface read_obj(const std::string& path) {
       continue;  // normals, texture coordinates, groups and materials do not affect the mesh
     } else if (key == "l" || key == "p") {
       throw InputError(quoted(path) + " " + where + ": '" + key +
-                       "' elements (lines or points) are not part of a quad surface");
+                       "' elements (lines or points) are not part of a quad surface; remove them and give "
+                       "only the 'v' and 'f' lines of the quads");
     } else {
       throw InputError(quoted(path) + " " + where + ": unknown OBJ line '" + line + "'");
     }
@@ -143,6 +144,22 @@ QuadSurface from_polydata(const std::string& path, vtkPolyData* poly) {
     throw InputError(quoted(path) + " is not VTK polydata with points (unreadable or empty file)");
   if (poly->GetNumberOfStrips() > 0)
     throw InputError(quoted(path) + " holds triangle strips; a quad surface holds only quads");
+  // Like an OBJ 'l' or 'p' line: edges or points exported with the surface would otherwise be dropped
+  // silently.
+  const vtkIdType lines = poly->GetNumberOfLines(), verts = poly->GetNumberOfVerts();
+  if (lines > 0 || verts > 0) {
+    const auto count = [](vtkIdType n, const std::string& what) {
+      return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+    };
+    const std::string found = lines > 0 && verts > 0
+                                  ? count(lines, "line cell") + " and " + count(verts, "vertex cell")
+                              : lines > 0 ? count(lines, "line cell")
+                                          : count(verts, "vertex cell");
+    throw InputError(quoted(path) + " holds " + found + " besides its " +
+                     count(poly->GetNumberOfPolys(), "polygon") +
+                     "; lines and points are not part of a quad surface: remove them (e.g. ParaView's "
+                     "Extract Cells By Type, keeping polygons) and give only the quads");
+  }
   const vtkIdType n = poly->GetNumberOfPoints();
   s.vertices.resize(static_cast<std::size_t>(n));
   for (vtkIdType i = 0; i < n; ++i) {

@@ -5,6 +5,11 @@
 
 namespace hexbite {
 
+// The largest coordinate (or vector component) accepted from a scenario or landmark file, in mm: a mandible
+// spans about 100 mm, so a component beyond a kilometre is a typo or a wrong unit, and near the double range
+// its squares overflow the geometric predicates.
+constexpr double kMaxCoordinateMm = 1e6;
+
 // Factor that converts a length in `unit` (mm, cm or m) to millimetres.
 // Throws InputError naming the accepted units for anything else.
 double unit_to_mm(const std::string& unit);

@@ -187,10 +187,7 @@ std::vector<Value> to_list(const Value& v) {
   return items;
 }
 
-// Coordinates and vectors in mm: a mandible spans about 100 mm, so a component beyond a kilometre is a
-// typo or a wrong unit, and near the double range its squares overflow the geometric predicates.
-constexpr double kMaxCoordinateMm = 1e6;
-
+// Coordinates and vectors in mm, each component within kMaxCoordinateMm (mesher/units.h).
 Vec3 to_vec3(const Value& v) {
   if (!v.node.IsSequence() || v.node.size() != 3)
     fail(v.at, v.path + " must be three numbers [x, y, z], found " + describe(v.node) +
@@ -538,10 +535,6 @@ double parse_activation(const Value& v) {
                    " but an activation must lie in [0, 1] (a fraction of the maximum force); write e.g. 0.5");
   return a;
 }
-
-// Far above any jaw muscle (all closers together give about 1 kN); a larger value is a typo or a wrong
-// unit, and a linear solve would scale it into absurd displacements and stresses.
-constexpr double kMaxMuscleForceN = 10000;
 
 Muscle default_muscle(const std::string& name, const SourceLocation& where) {
   Muscle m;

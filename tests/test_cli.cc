@@ -294,5 +294,26 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
 }
 
+// `--export inp` given twice (a script adding it to a command line that has it) stopped with CLI11's
+// "--export: At Most 1 required but received 2". The exports are a set: a repeat is accepted, a format other
+// than inp is still refused with what is allowed.
+TEST(CliBadInput, RepeatedExportIsAcceptedAndAnUnknownFormatNamed) {
+  const std::string dir = temp_dir();
+  const std::string missing = dir + "/missing.yaml";
+  auto r = run_hexbite({"run", missing, "-o", dir + "/out", "--export", "inp", "--export", "inp"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.find("At Most"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(missing), std::string::npos) << r.err;  // parsed; the scenario is what is missing
+  r = run_hexbite({"run", missing, "-o", dir + "/out", "--export", "inp", "--export", "vtk"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--export"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("inp"), std::string::npos) << r.err;
+  // The scenario is not taken as a second format.
+  r = run_hexbite({"run", "--export", "inp", missing, "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(missing), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("not in"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace hexbite

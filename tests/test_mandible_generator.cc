@@ -375,6 +375,39 @@ TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
   }
 }
 
+// Coordinates of 1e300 were accepted (the scenario's own are refused beyond 1e6 mm), and so was a muscle of
+// 1e9 N; a coordinate in range could also overflow to infinity when scaled to millimetres.
+TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  b: [0, 1e300, 0]\n",
+                        ":3: landmark 'b' coordinate is 1e+300, beyond 1e+06 mm in size");
+  expect_landmark_error("landmarks:\n  a: [-2000000, 0, 0]\n",
+                        ":2: landmark 'a' coordinate is -2e+06, beyond");
+  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n", ":2: landmark 'a' coordinate is not finite");
+  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n", ":2: landmark 'a' coordinate is not finite");
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: 1,\n     insertion: [0, 0, 0],\n     origin: [0, 0, 1e7]}\n",
+      ":4: muscle 'm' origin coordinate is 1e+07, beyond 1e+06 mm in size");
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: 1, insertion: [0, 1e300, 0], origin: [0, 0, 1]}\n",
+      ":2: muscle 'm' insertion coordinate is 1e+300, beyond");
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: 1e9, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
+      ":2: muscle 'm' max_force_N is 1e+09 N, more than 10000 N");
+  // In range in the file's unit, beyond it in millimetres.
+  const std::string path = test::temp_dir() + "/m.yaml";
+  test::write_file(path, "landmarks:\n  a: [0, 0, 5000]\n");
+  const std::string scaled =
+      test::message_of<InputError>([&] { read_landmarks(path, /*scale_to_mm=*/1000.0); });
+  EXPECT_NE(scaled.find(path + ":2: landmark 'a' coordinate is 5e+06 mm (5000 in the file's unit), beyond"),
+            std::string::npos)
+      << scaled;
+  // The bounds themselves are accepted.
+  test::write_file(path,
+                   "landmarks:\n  a: [1e6, -1e6, 0]\nmuscles:\n  - {name: m, max_force_N: 10000, "
+                   "insertion: [0, 0, 0], origin: [0, 0, 1]}\n");
+  EXPECT_EQ(read_landmarks(path).muscles.at(0).max_force_N, 10000.0);
+}
+
 // Every option within its range, but together a short, wide ramus at the largest gonial angle made a bone
 // of genus 2 (an opening through each ramus), written with exit 0 as if it were a mandible.
 TEST(MandibleGenerator, DimensionsThatGiveABoneWithHolesAreRefused) {

@@ -229,6 +229,56 @@ TEST(QuadSurfaceIo, CutOffVtpGivesVtksReason) {
       << msg;
 }
 
+// An OBJ 'l' line is refused, but the line cells of a .vtp or .vtk file were dropped silently: a file of
+// quads and lines (e.g. feature edges exported with the surface) was read as its quads alone.
+TEST(QuadSurfaceIo, LinesAndVerticesAreRefusedInEveryFormat) {
+  const std::string dir = test::temp_dir();
+  const std::string points =
+      "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 1 1 0 0 1 0"
+      "</DataArray></Points>\n";
+  const std::string polys =
+      "<Polys><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3</DataArray>"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">4</DataArray></Polys>\n";
+  const auto vtp = [&](const std::string& counts, const std::string& cells) {
+    return "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
+           "byte_order=\"LittleEndian\">\n<PolyData><Piece NumberOfPoints=\"4\" " +
+           counts + ">\n" + points + cells + "</Piece></PolyData>\n</VTKFile>\n";
+  };
+  test::write_file(dir + "/lines.vtp",
+                   vtp("NumberOfPolys=\"1\" NumberOfLines=\"2\"",
+                       "<Lines><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 2 1 3"
+                       "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2 4"
+                       "</DataArray></Lines>\n" +
+                           polys));
+  const std::string lines = error_of(dir + "/lines.vtp");
+  EXPECT_NE(lines.find("'" + dir + "/lines.vtp' holds 2 line cells besides its 1 polygon"), std::string::npos)
+      << lines;
+  EXPECT_NE(lines.find("remove them"), std::string::npos) << lines;
+  test::write_file(dir + "/verts.vtp",
+                   vtp("NumberOfPolys=\"1\" NumberOfVerts=\"1\"",
+                       "<Verts><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0"
+                       "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">1"
+                       "</DataArray></Verts>\n" +
+                           polys));
+  const std::string verts = error_of(dir + "/verts.vtp");
+  EXPECT_NE(verts.find("'" + dir + "/verts.vtp' holds 1 vertex cell besides its 1 polygon"),
+            std::string::npos)
+      << verts;
+  test::write_file(
+      dir + "/lines.vtk",
+      "# vtk DataFile Version 3.0\nquads\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0\n1 0 0\n"
+      "1 1 0\n0 1 0\nPOLYGONS 1 5\n4 0 1 2 3\nLINES 1 3\n2 0 2\n");
+  const std::string legacy = error_of(dir + "/lines.vtk");
+  EXPECT_NE(legacy.find("'" + dir + "/lines.vtk' holds 1 line cell besides"), std::string::npos) << legacy;
+  // The OBJ message says what to do too.
+  test::write_file(dir + "/lines.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nl 1 3\n");
+  const std::string obj = error_of(dir + "/lines.obj");
+  EXPECT_NE(obj.find("lines.obj' line 6: 'l' elements (lines or points) are not part of a quad surface"),
+            std::string::npos)
+      << obj;
+  EXPECT_NE(obj.find("remove them"), std::string::npos) << obj;
+}
+
 TEST(QuadCheckCli, ExitCodesAndMessages) {
   const std::string dir = test::temp_dir();
   write_quad_obj(dir + "/block.obj", test::block_surface(2, 3, 4));

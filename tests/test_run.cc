@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "common/number_format.h"
+#include "common/system_memory.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_mesh_io.h"
 #include "tests/test_util.h"
@@ -603,6 +605,86 @@ TEST(RunScenario, ValidationLevelsBeyondTheMachinesMemoryAreRefused) {
       expect_refused(text, "mesh.validation_levels 3 would solve level 3 on 2060800 hexes");
   EXPECT_NE(err.find("bad.yaml:4:"), std::string::npos) << err;
   EXPECT_NE(err.find("more than the"), std::string::npos) << err;
+}
+
+// A bite of a thousandth of a newton moves the bone by about 1e-6 mm: the summary table printed the
+// displacement as 0.00000, the bite force as 0.00 and the strain energy as 0.00000, as if nothing moved.
+TEST(RunScenario, SummaryTablePrintsTinyFiguresInScientificNotation) {
+  const std::string dir = test::temp_dir();
+  std::string text = kSmall;
+  const std::size_t from = text.find("activation_pattern:"), to = text.find("supports:");
+  text.replace(from, to - from,
+               "muscles:\n  - {name: right_superficial_masseter, activation: 1, max_force_N: 0.001}\n");
+  test::write_file(dir + "/weak.yaml", text);
+  const test::CommandResult r = test::run_hexbite({"run", dir + "/weak.yaml", "-o", dir + "/out"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json results = json::parse(test::read_file(dir + "/out/results.json"));
+  const double displacement = results["max_displacement_mm"].get<double>();
+  ASSERT_GT(displacement, 0.0);
+  ASSERT_LT(displacement, 5e-6);  // below what %.5f shows
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(max displacement \(mm\) +(\S+))"))) << r.out;
+  EXPECT_NEAR(std::stod(m[1]), displacement, 1e-3 * displacement) << r.out;
+  EXPECT_NE(m[1].str().find('e'), std::string::npos) << r.out;
+  for (const char* row : {"bite force \\(N\\)", "strain energy \\(mJ\\)"}) {
+    ASSERT_TRUE(std::regex_search(r.out, m, std::regex(std::string(row) + R"( +(\S+))"))) << r.out;
+    EXPECT_GT(std::stod(m[1]), 0.0) << row << " in\n" << r.out;
+  }
+}
+
+// The memory guard read the physical memory only: in a container limited by its cgroup to 4 GB of a 64 GB
+// machine it let through a level that needs 40 GB, which then ended in the out-of-memory kill.
+TEST(RunMemoryGuard, AvailableMemoryIsTheSmallerOfPhysicalMemoryAndTheCgroupLimit) {
+  const std::string dir = test::temp_dir();
+  const std::string v2 = dir + "/memory.max", v1 = dir + "/memory.limit_in_bytes", none = dir + "/none";
+  const double physical = 64e9;
+  // No cgroup files (or unreadable ones): the physical memory.
+  MemoryLimit m = available_memory(physical, none, none);
+  EXPECT_EQ(m.bytes, physical);
+  EXPECT_EQ(m.source, "this machine's physical memory");
+  // cgroup v2: "max" is no limit; a number below the physical memory is the limit.
+  test::write_file(v2, "max\n");
+  EXPECT_EQ(available_memory(physical, v2, none).bytes, physical);
+  test::write_file(v2, "4294967296\n");
+  m = available_memory(physical, v2, none);
+  EXPECT_EQ(m.bytes, 4294967296.0);
+  EXPECT_EQ(m.source, "the cgroup memory limit in " + v2);
+  // A limit above the physical memory changes nothing.
+  test::write_file(v2, "128000000000\n");
+  EXPECT_EQ(available_memory(physical, v2, none).source, "this machine's physical memory");
+  // cgroup v1: its "no limit" is the largest page-aligned 64-bit number.
+  test::write_file(v1, "9223372036854771712\n");
+  EXPECT_EQ(available_memory(physical, none, v1).source, "this machine's physical memory");
+  EXPECT_EQ(available_memory(0, none, v1).bytes, 0.0);  // nothing known
+  test::write_file(v1, "2147483648\n");
+  m = available_memory(physical, none, v1);
+  EXPECT_EQ(m.bytes, 2147483648.0);
+  EXPECT_EQ(m.source, "the cgroup memory limit in " + v1);
+  // Both (a hybrid hierarchy): the smaller; and a limit when the physical memory is not known.
+  test::write_file(v2, "4294967296\n");
+  EXPECT_EQ(available_memory(physical, v2, v1).source, "the cgroup memory limit in " + v1);
+  EXPECT_EQ(available_memory(0, v2, none).bytes, 4294967296.0);
+  // Text that is not a whole number sets no limit.
+  for (const char* text : {"", "\n", "-5\n", "4G\n", "0\n", "1e9\n"}) {
+    test::write_file(v2, text);
+    EXPECT_EQ(available_memory(physical, v2, none).source, "this machine's physical memory")
+        << "'" << text << "'";
+  }
+  // This machine: something known.
+  EXPECT_GT(machine_memory().bytes, 0.0);
+}
+
+// The summary table's figures (see SummaryTablePrintsTinyFiguresInScientificNotation).
+TEST(RunSummaryTable, FiguresThatFixedPointShowsAsZeroAreInScientificNotation) {
+  EXPECT_EQ(format_table_number(0.12345, 5, 14), "       0.12345");
+  EXPECT_EQ(format_table_number(3e-7, 5, 14), "      3.00e-07");
+  EXPECT_EQ(format_table_number(-3e-7, 5, 14), "     -3.00e-07");  // not "-0.00000"
+  EXPECT_EQ(format_table_number(0.0, 5, 14), "       0.00000");    // zero is zero
+  EXPECT_EQ(format_table_number(4e-6, 5, 14), "      4.00e-06");   // rounds to 0.00000
+  EXPECT_EQ(format_table_number(6e-6, 5, 14), "       0.00001");   // rounds to 0.00001
+  EXPECT_EQ(format_table_number(0.004, 2, 14), "      4.00e-03");
+  EXPECT_EQ(format_table_number(342.5, 2, 14), "        342.50");
+  EXPECT_EQ(format_table_number(1.5, 2, 6), "  1.50");
 }
 
 // A node on two fixed supports gives its whole reaction to the first one: a bite patch reaching a condyle's

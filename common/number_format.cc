@@ -1,0 +1,16 @@
+#include "common/number_format.h"
+
+#include <cstdio>
+
+namespace hexbite {
+
+std::string format_table_number(double value, int decimals, int width) {
+  char text[512];
+  std::snprintf(text, sizeof text, "%*.*f", width, decimals, value);
+  bool shows_a_digit = false;
+  for (const char* c = text; *c; ++c) shows_a_digit = shows_a_digit || (*c >= '1' && *c <= '9');
+  if (value != 0 && !shows_a_digit) std::snprintf(text, sizeof text, "%*.2e", width, value);
+  return text;
+}
+
+}  // namespace hexbite

@@ -1,0 +1,14 @@
+// Numbers in the text tables that commands print.
+#pragma once
+
+#include <string>
+
+namespace hexbite {
+
+// `value` right-aligned in `width` characters, in fixed point with `decimals` decimals ("%14.5f"), except
+// when fixed point would show a value that is not zero as zero ("0.00000" or "-0.00000" for 3e-7): that is
+// printed in scientific notation with 3 significant digits ("3.00e-07"), so that a small figure is never
+// mistaken for nothing. Not for files that programs read (results.json keeps full precision).
+std::string format_table_number(double value, int decimals, int width);
+
+}  // namespace hexbite
