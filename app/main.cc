@@ -70,6 +70,32 @@ int report(const std::string& text, int exit_code, MPI_Comm errors) {
   return exit_code;
 }
 
+// Whether the chosen subcommand (or its own subcommand) was given --json: its standard output is then one
+// JSON document, so informational lines go to standard error (set_json_output).
+bool json_requested(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands()) {
+    const CLI::Option* json = sub->get_option_no_throw("--json");
+    if ((json != nullptr && json->count() > 0) || json_requested(*sub)) return true;
+  }
+  return false;
+}
+
+// An option of one value given more than once (CLI11: "--levels: At Most 1 required but received 2"): the
+// message names it as --help lists it and says to give it once. Searches `app` and all its subcommands;
+// nullopt when no such option is found (the error is then CLI11's own).
+std::optional<std::string> repeated_option_message(const CLI::App& app) {
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->get_items_expected_max() == 1 && o->count() > 1 &&
+        o->get_multi_option_policy() == CLI::MultiOptionPolicy::Throw)
+      return o->get_name(false, true) + " was given " + std::to_string(o->count()) +
+             " times; it takes one value: give it once";
+  }
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (auto message = repeated_option_message(*sub)) return message;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -85,7 +111,10 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "No progress display and no informational output")->configurable(false);
   app.require_subcommand(1);
   app.fallthrough();  // --quiet may follow the subcommand
-  app.parse_complete_callback([&] { hexbite::set_quiet(quiet || !root); });
+  app.parse_complete_callback([&] {
+    hexbite::set_quiet(quiet || !root);
+    hexbite::set_json_output(json_requested(app));
+  });
 
   hexbite::add_surface_commands(app);
   hexbite::add_generate_commands(app);
@@ -105,6 +134,12 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::ArgumentMismatch& e) {
+    std::ostringstream text;
+    const std::optional<std::string> repeated = repeated_option_message(app);
+    // The message (which option was given twice, when that is the mismatch) and a hint to --help.
+    app.exit(repeated ? CLI::ArgumentMismatch(*repeated) : e, text, text);
+    return report(text.str(), hexbite::kExitBadInput, errors);
   } catch (const CLI::ParseError& e) {
     std::ostringstream text;
     app.exit(e, text, text);  // the message and a hint to --help

@@ -10,6 +10,7 @@ namespace hexbite {
 
 namespace {
 bool g_quiet = false;
+bool g_json = false;
 thread_local bool t_quiet = false;
 }  // namespace
 
@@ -32,8 +33,13 @@ QuietThread::~QuietThread() {
   t_quiet = before_;
 }
 
+void set_json_output(bool json) {
+  g_json = json;
+}
+
 void info(const std::string& line) {
-  if (!is_quiet()) std::cout << line << '\n';
+  if (is_quiet()) return;
+  (g_json ? std::cerr : std::cout) << line << '\n';
 }
 
 Progress::Progress(std::string label)

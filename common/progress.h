@@ -27,7 +27,11 @@ class QuietThread {
   bool before_;
 };
 
-// Prints an informational line to stdout unless quiet.
+// Set once from the command line when the command prints a JSON document (--json): standard output then
+// carries that document alone, and info() lines go to standard error.
+void set_json_output(bool json);
+
+// Prints an informational line unless quiet: to stdout, or to stderr under set_json_output(true).
 void info(const std::string& line);
 
 // A progress bar for one named step. On a terminal (stderr is a TTY) it redraws

@@ -1,5 +1,5 @@
-// The hexbite command line as a user meets it: help and version, usage errors, and
-// `hexbite surface check` on good and bad input (exit codes, messages, no output file on failure).
+// The hexbite command line as a user meets it: help and version, usage errors, `hexbite surface check` on
+// good and bad input (exit codes, messages, no output file on failure), and --json output that is JSON alone.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -292,6 +292,67 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   EXPECT_TRUE(fs::is_empty(dir));
   // Any case of the extension is fine.
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
+}
+
+// With --json, standard output is one JSON document, also without --quiet: `hexbite run ... --json | jq`
+// broke on the informational lines (the run's "not resolved: ..." parts) printed before the JSON. Every
+// command that has --json, on a small generated mandible and the shipped default scenario.
+TEST(Cli, JsonOutputIsOnlyJsonWithoutQuiet) {
+  const std::string dir = temp_dir();
+  const std::string jaw = dir + "/jaw.stl", landmarks = dir + "/jaw.yaml";
+  auto r = run_hexbite({"generate", "mandible", "-o", jaw, "--landmarks", landmarks, "--voxel", "1.5"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::vector<std::string>> commands = {
+      {"surface", "check", jaw},
+      {"surface", "clean", jaw, "-o", dir + "/clean.stl"},
+      {"mesh", jaw, "--landmarks", landmarks, "--target-hexes", "1000", "-o", dir + "/grid.vtu"},
+      {"quality", dir + "/grid.vtu"},
+      {"refine", dir + "/grid.vtu", "--surface", jaw, "-o", dir + "/fine.vtu"},
+      {"reorder", dir + "/grid.vtu", "-o", dir + "/ordered.vtu"},
+      {"quad", "from-mandible", jaw, "--landmarks", landmarks, "-o", dir + "/quads.obj"},
+      {"quad", "check", dir + "/quads.obj"},
+      {"run", std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml", "-o", dir + "/run",
+       "--levels", "0"},
+  };
+  for (std::vector<std::string> args : commands) {
+    args.push_back("--json");
+    r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 0) << args[0] << "\n" << r.err;
+    EXPECT_TRUE(nlohmann::json::accept(r.out)) << args[0] << ": standard output is not one JSON document:\n"
+                                               << r.out.substr(0, 400);
+  }
+  // The run's informational lines went to standard error instead.
+  EXPECT_NE(r.err.find("not resolved: "), std::string::npos) << r.err;
+}
+
+// An option of one value given twice stopped with CLI11's "--levels: At Most 1 required but received 2",
+// which names neither what is wrong nor what to do. Now, for every command: which option, and to give it
+// once.
+TEST(CliBadInput, OptionOfOneValueGivenTwiceIsNamed) {
+  const std::string dir = temp_dir();
+  const std::string cube = write_case("cube.obj", cube_obj());
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"run", dir + "/s.yaml", "-o", dir + "/out", "--levels", "1", "--levels", "2"},
+       "--levels was given 2 times; it takes one value: give it once"},
+      {{"mesh", cube, "-o", dir + "/a.vtu", "--output", dir + "/b.vtu"},
+       "-o,--output was given 2 times; it takes one value: give it once"},
+      {{"mesh", cube, "-o", dir + "/a.vtu", "--target-hexes", "100", "--target-hexes", "200",
+        "--target-hexes", "300"},
+       "--target-hexes was given 3 times; it takes one value: give it once"},
+      {{"surface", "check", cube, "--units", "mm", "--units", "m"},
+       "--units was given 2 times; it takes one value: give it once"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("At Most"), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
 }
 
 // `--export inp` given twice (a script adding it to a command line that has it) stopped with CLI11's
