@@ -46,6 +46,7 @@ struct MeshOptions {
   bool json = false;
   bool allow_invalid = false;
   bool fit_volume = false;
+  std::string grid_frame = "axes";  // --method grid: axes or arch (mesher/arch_frame.h)
   double margin = GridMeshOptions{}.margin;
   bool margin_given = false;        // --margin on the command line: that margin everywhere, on three grids
   std::string quad_surface;         // --method sheets
@@ -83,9 +84,9 @@ std::string phase_table(const OptimizeReport& r) {
 std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r) {
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
-  out << "Meshed " << o.surface << " (grid + pillow): " << mesh.hexes.size() << " hexes (" << r.core_hexes
-      << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
-      << "\n";
+  out << "Meshed " << o.surface << " (grid + pillow" << (o.grid_frame == "arch" ? ", along the arch" : "")
+      << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes << " core + " << r.pillow_hexes
+      << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core"
       << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string())
@@ -128,6 +129,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["cells_added_for_manifold"] = r.cells_added_for_manifold;
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
   j["grid_attempts"] = r.attempts;
+  j["grid_frame"] = o.grid_frame;
   j["landmarks"] = o.landmarks.empty() ? nlohmann::json() : nlohmann::json(o.landmarks);
   nlohmann::json phases = nlohmann::json::array();
   for (const PhaseQuality& p : r.optimize.phases)
@@ -175,6 +177,7 @@ void run_mesh(const MeshOptions& o) {
   options.target_hexes = o.target;
   options.margin = o.margin;
   options.fit_volume = o.fit_volume;
+  options.arch_frame = o.grid_frame == "arch";
   // An explicit margin is a request for that core: no automatic choice of cores for fine cells.
   if (o.margin_given) options.thick_margin_cells = std::numeric_limits<double>::infinity();
   GridMeshReport report;
@@ -237,6 +240,11 @@ void add_mesh_command(CLI::App& app) {
                       "for fine cells the better of two cores (docs/meshing.md)")
           ->check(CLI::Range(-0.8, 2.0))
           ->default_val(o->margin);
+  cmd->add_option("--grid-frame", o->grid_frame,
+                  "Frame of the overlay grid for --method grid: axes, or arch (along the dental arch of a "
+                  "whole mandible in the mandible frame; docs/meshing.md)")
+      ->check(CLI::IsMember({"axes", "arch"}))
+      ->capture_default_str();
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "Move the boundary nodes off the SURFACE along their normals until the "
                 "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "

@@ -114,8 +114,16 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   GridMeshOptions options;
   options.target_hexes = s.mesh.target_hexes;
   options.fit_volume = s.mesh.fit_volume;
+  options.arch_frame = s.mesh.arch_frame;
   GridMeshReport report;
-  HexMesh mesh = grid_mesh(geometry.surface, options, &report);
+  HexMesh mesh;
+  try {
+    mesh = grid_mesh(geometry.surface, options, &report);
+  } catch (const InputError& e) {
+    // A bone that follows no arch is the scenario's grid_frame's fault.
+    if (!s.mesh.arch_frame) throw;
+    throw InputError(s.mesh.grid_frame_at.str() + ": mesh.grid_frame arch: " + e.what());
+  }
   if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <future>
 #include <limits>
+#include <memory>
 #include <numeric>
+#include <optional>
 #include <queue>
 #include <sstream>
 #include <thread>
@@ -14,6 +16,7 @@
 
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/arch_frame.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality_kernel.h"
 #include "mesher/surface_projector.h"
@@ -44,8 +47,7 @@ std::string format_point(const Vec3& p) {
 // at this cell size.
 struct MissedBody {
   int body = -1;
-  Vec3 lo{}, hi{};  // the bounding box of its outer shell
-  int cells = 0;    // cells of dropped components nearest to it
+  int cells = 0;  // cells of dropped components nearest to it
 };
 
 // Bodies that one core component holds: the gap between them is narrower than a cell, the mesh joins them.
@@ -426,7 +428,7 @@ void keep_main_components(Selection& s, const SurfaceProjector& surface, const S
   for (int b = 0; b < shells.bodies; ++b)
     if (main_of[b] < 0) {
       missed_index[b] = int(s.missed.size());
-      s.missed.push_back({b, shells.body_lo[b], shells.body_hi[b], 0});
+      s.missed.push_back({b, 0});
     }
   Vec3 sum{0, 0, 0};
   for (long c = 0; c < nc; ++c) {
@@ -1062,9 +1064,11 @@ enum class CoreRule {
 };
 
 // Steps 1 and 2 of one grid, shifted by `shift` cells: the cell size and the core (`mesh` holds the core).
+// With an arch frame, `projector` and `shells` are those of the straightened surface (arch coordinates), and
+// the core's vertices are mapped back to the body.
 GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, const Vec3& lo, const Vec3& hi,
                       double volume, double mean_thickness, const GridMeshOptions& options, double shift,
-                      CoreRule rule) {
+                      CoreRule rule, const ArchFrame* arch) {
   const auto t_attempt = std::chrono::steady_clock::now();
   GridAttempt out;
   GridMeshReport& r = out.report;
@@ -1121,6 +1125,8 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, c
   for (const MissedBody& m : best.missed) r.cells_in_dropped_components += m.cells;
   std::tie(r.core_boundary_vertices, r.irregular_core_boundary_vertices) = boundary_valences(best);
   out.mesh = core_mesh(best);
+  if (arch)
+    for (Vec3& v : out.mesh.vertices) v = arch->to_body(v);
   r.core_hexes = int(out.mesh.hexes.size());
   r.seconds_core = seconds_since(t_attempt);
   return out;
@@ -1150,13 +1156,29 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   const double volume = enclosed_volume(surface);
   if (!(volume > 0))
     throw InputError("grid mesher: the surface encloses no volume (is it oriented outward?)");
+  // With the arch frame the core is selected on the straightened surface (arch coordinates) and its
+  // vertices mapped back; the pillow layer, the optimization and the fidelity work on the surface itself.
+  std::optional<ArchFrame> arch;
+  TriSurface straightened;
+  std::unique_ptr<SurfaceProjector> straightened_projector;
+  if (options.arch_frame) {
+    arch.emplace(surface);
+    straightened = surface;
+    for (Vec3& v : straightened.vertices) v = arch->to_arch(v);
+    straightened_projector = std::make_unique<SurfaceProjector>(straightened);
+  }
+  const TriSurface& grid_surface = arch ? straightened : surface;
+  const SurfaceProjector& grid_projector = arch ? *straightened_projector : projector;
+  const Shells grid_shells = arch ? find_shells(straightened) : shells;
+  const double grid_volume = arch ? enclosed_volume(straightened) : volume;
+  const ArchFrame* arch_frame = arch ? &*arch : nullptr;
   double area = 0;
-  for (const auto& t : surface.triangles)
-    area += 0.5 * norm(cross(sub(surface.vertices[t[1]], surface.vertices[t[0]]),
-                             sub(surface.vertices[t[2]], surface.vertices[t[0]])));
-  const double mean_thickness = 2.0 * volume / area;
+  for (const auto& t : grid_surface.triangles)
+    area += 0.5 * norm(cross(sub(grid_surface.vertices[t[1]], grid_surface.vertices[t[0]]),
+                             sub(grid_surface.vertices[t[2]], grid_surface.vertices[t[0]])));
+  const double mean_thickness = 2.0 * grid_volume / area;
   Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
-  for (const Vec3& p : surface.vertices)
+  for (const Vec3& p : grid_surface.vertices)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
 
   // Where a thin part cuts through a cell decides how its hexes look: a grid can leave a tangle that the
@@ -1212,8 +1234,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   auto run_job = [&](int a) {
     try {
       if (a > 0)
-        attempts[a] = grid_core(projector, shells, lo, hi, volume, mean_thickness, options, jobs[a].shift,
-                                jobs[a].rule);
+        attempts[a] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
+                                jobs[a].shift, jobs[a].rule, arch_frame);
       pillow_and_optimize(attempts[a], projector, per_grid);
     } catch (...) {
       errors[a] = std::current_exception();
@@ -1235,8 +1257,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     std::vector<std::thread> helpers;
     for (int t = 1; t < std::clamp(options.threads, 1, 4); ++t) helpers.emplace_back(work, true);
     try {
-      attempts[0] =
-          grid_core(projector, shells, lo, hi, volume, mean_thickness, options, shifts[0], jobs[0].rule);
+      attempts[0] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
+                              shifts[0], jobs[0].rule, arch_frame);
       decide_jobs(attempts[0].fine);
       run_job(0);
     } catch (...) {
@@ -1318,10 +1340,10 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   report.fidelity = measure_fidelity(mesh, projector);
   if (kept.dropped > 0) {
     UnresolvedPart part;
-    part.location = kept.dropped_centroid;
+    part.location = arch ? arch->to_body(kept.dropped_centroid) : kept.dropped_centroid;
     part.samples = kept.dropped;
     part.what =
-        std::to_string(kept.dropped) + " grid cells around " + format_point(kept.dropped_centroid) +
+        std::to_string(kept.dropped) + " grid cells around " + format_point(part.location) +
         " were not face-connected to the main core and were dropped (a narrow neck at this cell size)";
     report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
   }
@@ -1330,7 +1352,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   cell << std::fixed << kept.grid.h;
   for (auto j = kept.joined.rbegin(); j != kept.joined.rend(); ++j) {
     UnresolvedPart part;
-    part.location = j->contact;
+    part.location = arch ? arch->to_body(j->contact) : j->contact;
     std::string around;
     for (int b : j->bodies)
       around += (around.empty()          ? ""
@@ -1344,18 +1366,20 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   }
   for (auto m = kept.missed.rbegin(); m != kept.missed.rend(); ++m) {
     UnresolvedPart part;
-    part.location = scale(add(m->lo, m->hi), 0.5);
+    // The body's box on the surface itself (not in arch coordinates).
+    const Vec3 &body_lo = shells.body_lo[m->body], &body_hi = shells.body_hi[m->body];
+    part.location = scale(add(body_lo, body_hi), 0.5);
     part.samples = int(shells.body_triangles[m->body]);
     std::ostringstream size;
     size.precision(1);
-    size << std::fixed << m->hi[0] - m->lo[0] << " x " << m->hi[1] - m->lo[1] << " x " << m->hi[2] - m->lo[2]
-         << " mm";
+    size << std::fixed << body_hi[0] - body_lo[0] << " x " << body_hi[1] - body_lo[1] << " x "
+         << body_hi[2] - body_lo[2] << " mm";
     // The fidelity check finds the same shell far from the mesh: its distance goes here, once.
     auto& found = report.fidelity.unresolved;
     for (auto f = found.begin(); f != found.end(); ++f) {
       bool in_box = f->what.rfind("the whole separate shell near", 0) == 0;
       for (int a = 0; a < 3; ++a)
-        in_box = in_box && f->location[a] >= m->lo[a] - 1e-9 && f->location[a] <= m->hi[a] + 1e-9;
+        in_box = in_box && f->location[a] >= body_lo[a] - 1e-9 && f->location[a] <= body_hi[a] + 1e-9;
       if (!in_box) continue;
       part.extent = f->extent;
       found.erase(f);

@@ -106,6 +106,10 @@ struct GridMeshOptions {
   int grids = 3;
   // Grids meshed at once, each in its own thread (1 to 4); the mesh does not depend on it.
   int threads = 2;
+  // Lay the grid along the dental arch (mesher/arch_frame.h: the core is selected in arch coordinates and
+  // mapped back before the pillow layer) instead of along the axes; for a whole mandible in the mandible
+  // frame (throws InputError for a surface that does not follow an arch).
+  bool arch_frame = false;
   // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass, twice,
   // with the condition stage (kappa 9.9: the kappa <= 10 with a margin; on the real jaw at 2,500
   // hexes stage 1 stalls at 10.79 on the thin rami), and the mean stage (on the kept grid only) with the

@@ -401,7 +401,7 @@ LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, cons
 
 MeshSettings parse_mesh(const Value& v) {
   const Map map(v, {"method", "target_hexes", "validation_levels", "refine_at_bite", "refine_radius_mm",
-                    "refine_levels", "fit_volume"});
+                    "refine_levels", "fit_volume", "grid_frame"});
   MeshSettings m;
   if (auto x = map.find("method")) {
     m.method = to_choice<MeshMethod>(*x, {{"grid", MeshMethod::kGrid}, {"sheets", MeshMethod::kSheets}});
@@ -449,6 +449,14 @@ MeshSettings parse_mesh(const Value& v) {
                       " (rings of quads around the bite point); the default is 3");
   }
   if (auto x = map.find("fit_volume")) m.fit_volume = to_bool(*x);
+  if (auto x = map.find("grid_frame")) {
+    m.arch_frame = to_choice<bool>(*x, {{"axes", false}, {"arch", true}});
+    m.grid_frame_at = x->at;
+    if (m.method != MeshMethod::kGrid)
+      fail(x->at,
+           "mesh.grid_frame lays the overlay grid of method grid, but mesh.method is sheets; remove "
+           "grid_frame or write method: grid");
+  }
   return m;
 }
 

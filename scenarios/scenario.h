@@ -77,6 +77,9 @@ struct MeshSettings {
   // boundary nodes moved off the surface until the mesh's volume matches (mesher/boundary_fit.h), on the
   // coarse mesh and on every validation level.
   bool fit_volume = false;
+  // method grid only: lay the overlay grid along the dental arch (GridMeshOptions::arch_frame).
+  bool arch_frame = false;
+  SourceLocation grid_frame_at;  // where grid_frame was written
 };
 
 struct MaterialSpec {

@@ -403,12 +403,12 @@ TEST(RunScenario, MaterialRegionHoldingNoHexIsRefusedAtItsLine) {
   EXPECT_NE(err.find("mm outside it: move it into the bone or enlarge it"), std::string::npos) << err;
 }
 
-// Two separate 20 mm cubes (x 0-20 and 40-60) as OBJ text, outward triangles.
-std::string two_cubes_obj() {
+// Separate 20 mm cubes (x 0-20, 40-60, ...) as OBJ text, outward triangles.
+std::string cubes_obj(int cubes) {
   std::string text;
   const int faces[12][3] = {{1, 3, 4}, {1, 4, 2}, {5, 6, 8}, {5, 8, 7}, {1, 2, 6}, {1, 6, 5},
                             {3, 7, 8}, {3, 8, 4}, {1, 5, 7}, {1, 7, 3}, {2, 4, 8}, {2, 8, 6}};
-  for (int cube = 0; cube < 2; ++cube) {
+  for (int cube = 0; cube < cubes; ++cube) {
     for (int v = 0; v < 8; ++v)
       text += "v " + std::to_string(40 * cube + 20 * (v & 1)) + " " + std::to_string(20 * ((v >> 1) & 1)) +
               " " + std::to_string(20 * ((v >> 2) & 1)) + "\n";
@@ -434,7 +434,7 @@ supports:
 outputs: {bite_force: false}
 )";
   const std::string path = write_scenario(scenario);
-  test::write_file(fs::path(path).parent_path().string() + "/two_cubes.obj", two_cubes_obj());
+  test::write_file(fs::path(path).parent_path().string() + "/two_cubes.obj", cubes_obj(2));
   const std::string dir = test::temp_dir() + "/out";
   test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
   EXPECT_EQ(r.exit_code, 2) << r.err;
@@ -456,6 +456,27 @@ outputs: {bite_force: false}
   test::write_file(path, held);
   const json j = run_scenario(path, dir);
   EXPECT_LT(j["equilibrium_residual"].get<double>(), 1e-8);
+}
+
+// A grid along the dental arch of a bone that follows no arch (a cube): refused at the scenario's grid_frame.
+TEST(RunScenario, GridFrameArchOfABoneWithoutAnArchIsRefusedAtItsLine) {
+  const std::string path = write_scenario(R"(name: cube
+geometry:
+  surface: {file: cube.obj}
+mesh: {target_hexes: 500, validation_levels: 0, grid_frame: arch}
+muscles:
+  - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
+supports:
+  - {name: base, at: [0, 10, 10], radius_mm: 5}
+outputs: {bite_force: false}
+)");
+  test::write_file(fs::path(path).parent_path().string() + "/cube.obj", cubes_obj(1));
+  const std::string dir = test::temp_dir() + "/out";
+  const test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(path + ":4:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mesh.grid_frame arch: arch frame: "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir));
 }
 
 // A CT geometry whose threshold every voxel reaches: the surface would be the box of the scan, which

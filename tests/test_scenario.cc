@@ -286,6 +286,16 @@ TEST(Scenario, FitVolumeIsReadForBothMethods) {
                   "mesh.fit_volume must be true or false");
 }
 
+// mesh.grid_frame (axes or arch) is read for the grid method and refused for the sheets method.
+TEST(Scenario, GridFrameIsReadForTheGridMethodOnly) {
+  EXPECT_FALSE(load_scenario(write_scenario(kValid)).mesh.arch_frame);
+  EXPECT_TRUE(load_scenario(write_scenario(kValid + "mesh: {grid_frame: arch}\n")).mesh.arch_frame);
+  EXPECT_FALSE(load_scenario(write_scenario(kValid + "mesh: {grid_frame: axes}\n")).mesh.arch_frame);
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {grid_frame: curved}\n"), 11, "'curved'");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh:\n  method: sheets\n  grid_frame: arch\n"), 13,
+                  "mesh.grid_frame lays the overlay grid of method grid, but mesh.method is sheets");
+}
+
 TEST(ScenarioErrors, RepeatedKey) {
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    activation: 0.6")), 7,
