@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_inputs.h"
 #include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
@@ -22,9 +23,7 @@
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
-#include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
-#include "mesher/units.h"
 #include "mesher/vec3.h"
 #include "postprocess/quality_json.h"
 
@@ -199,7 +198,7 @@ void run_refine(const RefineCliOptions& o) {
                      "; use fewer levels");
   std::unique_ptr<SurfaceProjector> projector;
   if (!o.surface.empty()) {
-    projector = std::make_unique<SurfaceProjector>(load_closed_surface(o.surface, unit_to_mm(o.units)));
+    projector = std::make_unique<SurfaceProjector>(load_surface_input(o.surface, o.units));
     require_mesh_on_surface(coarse, *projector, o);
   }
 

@@ -14,13 +14,12 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_inputs.h"
 #include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
-#include "mesher/surface_check.h"
 #include "mesher/surface_clean.h"
 #include "mesher/surface_io.h"
-#include "mesher/units.h"
 
 namespace hexbite {
 
@@ -99,8 +98,7 @@ std::string report_text(const CleanReport& r, double min_angle_deg, const std::s
 void run_clean(const CleanCommandOptions& o) {
   // Options first: a typo there should not wait for a large file to be read.
   validate_clean_options(o.clean);
-  const double scale = unit_to_mm(o.units);
-  const TriSurface surface = load_closed_surface(o.input, scale);
+  const TriSurface surface = load_surface_input(o.input, o.units);
   CleanReport report;
   const TriSurface cleaned = clean_surface(surface, o.clean, &report);
   write_surface(o.output, cleaned);

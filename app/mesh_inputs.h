@@ -1,9 +1,9 @@
-// The inputs of the commands that mesh a triangulated bone (`mesh SURFACE --method grid|sheets`, `quad
-// from-mandible`): the SURFACE, closed and in millimetres, and the optional --landmarks file in the same
-// unit. Each gets a warning on standard error when it does not fit: a size no mandible has (a file in
-// metres read as millimetres), or a landmark file written for another bone, frame or unit
-// (landmark_fit_warning()). Errors (unreadable, open or non-manifold surfaces, malformed landmark files)
-// are InputErrors from the loaders.
+// The inputs of the commands that read a triangulated bone (`mesh SURFACE --method grid|sheets`, `quad
+// from-mandible`, `surface clean`, `refine --surface`): the SURFACE, closed and in millimetres, and for the
+// meshing commands the optional --landmarks file in the same unit. Each gets a warning on standard error when
+// it does not fit: a size no mandible has (a file in metres read as millimetres), or a landmark file written
+// for another bone, frame or unit (landmark_fit_warning()). Errors (unreadable, open or non-manifold
+// surfaces, malformed landmark files) are InputErrors from the loaders.
 #pragma once
 
 #include <memory>
@@ -18,6 +18,9 @@ struct MeshInputs {
   TriSurface surface;
   std::unique_ptr<Landmarks> landmarks;  // nullptr without --landmarks
 };
+
+// The closed SURFACE in millimetres (`units`: its unit, mm, cm or m), with the size warning.
+TriSurface load_surface_input(const std::string& surface_file, const std::string& units);
 
 // `units`: the unit of both files (mm, cm or m); `landmark_file` empty: no landmarks.
 MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& units,

@@ -157,6 +157,15 @@ TEST(Cli, SurfaceInMetresWithoutUnitsIsWarnedAbout) {
   EXPECT_NE(r.err.find("hexbite: warning: '" + path + "': the surface is only 0.02 mm across"),
             std::string::npos)
       << r.err;
+  // So do the other commands that read a surface: surface clean, and refine with --surface.
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"surface", "clean", path, "-o", temp_dir() + "/clean.stl"},
+        std::vector<std::string>{"refine", mesh, "--surface", path, "-o", temp_dir() + "/fine.vtu"}}) {
+    r = run_hexbite(args);
+    EXPECT_NE(r.err.find("hexbite: warning: '" + path + "': the surface is only 0.02 mm across"),
+              std::string::npos)
+        << args[0] << ": " << r.err;
+  }
 }
 
 TEST(Cli, RepairedSurfaceIsWrittenInMillimetres) {
