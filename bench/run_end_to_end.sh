@@ -34,12 +34,14 @@ echo "| surface check | real jaw (41,760 triangles) | $(best_of "$hexbite" -q su
 echo "| surface clean | built-in mandible | $(best_of "$hexbite" -q surface clean "$work/jaw.stl" -o "$work/clean1.stl") |"
 echo "| surface clean | real jaw | $(best_of "$hexbite" -q surface clean "$jaw" -o "$work/clean2.stl") |"
 
-# Meshing (issues 3 and 4): the grid mesher at the paper's coarse size and at 30,000 hexes, the sheet
-# mesher with landmarks, and with the local refinement around a bite point.
+# Meshing (issues 3 and 4): the grid mesher at the paper's coarse size and at 30,000 hexes (also with the
+# grid along the dental arch), the sheet mesher with landmarks, and with the local refinement around a bite
+# point.
 landmarks=../shared/data/jaw/landmarks.yaml
 for target in 2500 30000; do
   echo "| mesh --method grid --target-hexes $target | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method grid --target-hexes "$target" -o "$work/grid.vtu") |"
 done
+echo "| mesh --method grid --grid-frame arch --target-hexes 30000 | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method grid --grid-frame arch --target-hexes 30000 -o "$work/grid_arch.vtu") |"
 echo "| mesh --method sheets --landmarks | built-in mandible | $(best_of "$hexbite" -q mesh "$work/jaw.stl" --method sheets --landmarks "$work/jaw.yaml" -o "$work/sheets1.vtu") |"
 echo "| mesh --method sheets --landmarks | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method sheets --landmarks "$landmarks" -o "$work/sheets2.vtu") |"
 echo "| mesh --method sheets --landmarks --refine-at right_first_molar_bite_point | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method sheets --landmarks "$landmarks" --refine-at right_first_molar_bite_point -o "$work/sheets3.vtu") |"
