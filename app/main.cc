@@ -96,6 +96,27 @@ std::optional<std::string> repeated_option_message(const CLI::App& app) {
   return std::nullopt;
 }
 
+// A command level that needs a command and was given none (CLI11 says only "A subcommand is required",
+// also when the word given is a typo): the message names the word left over, if any, and lists the
+// commands of that level with where to read about them. nullopt when the missing piece is something else.
+std::optional<std::string> missing_command_message(const CLI::App& app) {
+  const CLI::App* level = &app;
+  std::string chosen;  // the commands given, "surface " for `hexbite surface nosuch`
+  for (auto given = app.get_subcommands(); !given.empty(); given = level->get_subcommands()) {
+    level = given.front();
+    chosen += level->get_name() + " ";
+  }
+  if (level->get_require_subcommand_min() == 0) return std::nullopt;
+  std::string commands;
+  for (const CLI::App* sub :
+       level->get_subcommands([](const CLI::App* a) { return !a->get_group().empty(); }))
+    commands += (commands.empty() ? "" : ", ") + sub->get_name();
+  const std::string list = "the " + chosen + "commands are: " + commands + " (hexbite " + chosen + "--help)";
+  for (const std::string& word : app.remaining(true))
+    if (!word.empty() && word[0] != '-') return "unknown command '" + chosen + word + "'; " + list;
+  return "a command is required; " + list;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -139,6 +160,12 @@ int main(int argc, char** argv) {
     const std::optional<std::string> repeated = repeated_option_message(app);
     // The message (which option was given twice, when that is the mismatch) and a hint to --help.
     app.exit(repeated ? CLI::ArgumentMismatch(*repeated) : e, text, text);
+    return report(text.str(), hexbite::kExitBadInput, errors);
+  } catch (const CLI::RequiredError& e) {
+    if (const std::optional<std::string> missing = missing_command_message(app))
+      return report("hexbite: error: " + *missing + '\n', hexbite::kExitBadInput, errors);
+    std::ostringstream text;
+    app.exit(e, text, text);
     return report(text.str(), hexbite::kExitBadInput, errors);
   } catch (const CLI::ParseError& e) {
     std::ostringstream text;

@@ -593,29 +593,35 @@ MandibleVariant parse_variant(const std::string& name) {
   throw InputError("unknown mandible variant '" + name + "'; use dentate, edentulous or atrophic");
 }
 
-MandibleParameters complete_parameters(MandibleParameters p) {
-  const MandibleParameters d = defaults_for(p.variant);
-  auto fill = [](double& value, double fallback) {
-    if (value == 0) value = fallback;
-  };
-  fill(p.voxel_mm, 1.0);
-  fill(p.arch_width_mm, d.arch_width_mm);
-  fill(p.arch_depth_mm, d.arch_depth_mm);
-  fill(p.body_height_mm, d.body_height_mm);
-  fill(p.body_thickness_mm, d.body_thickness_mm);
-  fill(p.ramus_height_mm, d.ramus_height_mm);
-  fill(p.ramus_width_mm, d.ramus_width_mm);
-  fill(p.gonial_angle_deg, d.gonial_angle_deg);
+const std::vector<MandibleDimension>& mandible_dimensions() {
   // The ranges span adult anatomy with room for what-if studies, and keep the thinnest part (the
   // 6.5 mm ramus plate, the atrophic ridge) at least four voxels across.
-  check_range("voxel", p.voxel_mm, 0.25, 1.5);
-  check_range("arch-width", p.arch_width_mm, 75, 120);
-  check_range("arch-depth", p.arch_depth_mm, 40, 75);
-  check_range("body-height", p.body_height_mm, 8, 40);
-  check_range("body-thickness", p.body_thickness_mm, 8, 20);
-  check_range("ramus-height", p.ramus_height_mm, 40, 75);
-  check_range("ramus-width", p.ramus_width_mm, 22, 40);
-  check_range("gonial-angle", p.gonial_angle_deg, 105, 140);
+  using P = MandibleParameters;
+  static const std::vector<MandibleDimension> dimensions = {
+      {"voxel", "voxel_mm", "mm", &P::voxel_mm, 0.25, 1.5},
+      {"arch-width", "arch_width_mm", "mm", &P::arch_width_mm, 75, 120},
+      {"arch-depth", "arch_depth_mm", "mm", &P::arch_depth_mm, 40, 75},
+      {"body-height", "body_height_mm", "mm", &P::body_height_mm, 8, 40},
+      {"body-thickness", "body_thickness_mm", "mm", &P::body_thickness_mm, 8, 20},
+      {"ramus-height", "ramus_height_mm", "mm", &P::ramus_height_mm, 40, 75},
+      {"ramus-width", "ramus_width_mm", "mm", &P::ramus_width_mm, 22, 40},
+      {"gonial-angle", "gonial_angle_deg", "deg", &P::gonial_angle_deg, 105, 140}};
+  return dimensions;
+}
+
+MandibleParameters mandible_defaults(MandibleVariant variant) {
+  MandibleParameters d = defaults_for(variant);
+  d.voxel_mm = 1.0;
+  return d;
+}
+
+MandibleParameters complete_parameters(MandibleParameters p) {
+  const MandibleParameters d = mandible_defaults(p.variant);
+  for (const MandibleDimension& dim : mandible_dimensions()) {
+    double& value = p.*dim.field;
+    if (value == 0) value = d.*dim.field;
+    check_range(dim.option, value, dim.lo, dim.hi);
+  }
   return p;
 }
 

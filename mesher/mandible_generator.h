@@ -27,9 +27,26 @@ struct MandibleParameters {
   double gonial_angle_deg = 0;   // between the posterior ramus border and the lower border
 };
 
+// One number of MandibleParameters with the range the generator accepts (which keeps each part at least
+// four voxels thick, so sampling never changes the topology). The one table for `hexbite generate
+// mandible`'s options and a scenario's geometry.mandible keys.
+struct MandibleDimension {
+  const char* option;        // the generate option without its dashes: "arch-width"
+  const char* scenario_key;  // the key under a scenario's geometry.mandible: "arch_width_mm"
+  const char* unit;          // "mm" or "deg"
+  double MandibleParameters::*field;
+  double lo, hi;  // accepted: lo <= value <= hi
+};
+
+// Every dimension, the voxel size first.
+const std::vector<MandibleDimension>& mandible_dimensions();
+
+// The chosen variant's value of every field (voxel 1 mm); none is zero.
+MandibleParameters mandible_defaults(MandibleVariant variant);
+
 // Fills the zero fields above with the defaults of the chosen variant, then checks every value
-// against its accepted range (which keeps each part at least four voxels thick, so sampling never
-// changes the topology); throws InputError naming the parameter and the range otherwise.
+// against its accepted range (mandible_dimensions); throws InputError naming the parameter as a
+// generate option and the range otherwise.
 MandibleParameters complete_parameters(MandibleParameters p);
 
 // "dentate", "edentulous" or "atrophic"; parse_variant throws InputError for anything else.

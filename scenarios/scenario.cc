@@ -328,26 +328,28 @@ GeometrySpec parse_geometry(const Ctx& ctx, const Value& v) {
                                    "; keep exactly one geometry source");
   if (map.has("mandible")) {
     g.source = GeometrySource::kMandible;
-    const Map m(map.get("mandible"),
-                {"variant", "voxel_mm", "arch_width_mm", "arch_depth_mm", "body_height_mm",
-                 "body_thickness_mm", "ramus_height_mm", "ramus_width_mm", "gonial_angle_deg"});
+    std::vector<std::string> keys = {"variant"};
+    for (const MandibleDimension& d : mandible_dimensions()) keys.push_back(d.scenario_key);
+    const Map m(map.get("mandible"), keys);
     MandibleParameters& p = g.mandible;
     if (auto x = m.find("variant")) p.variant = to_choice(*x, kVariants);
-    const std::pair<const char*, double*> lengths[] = {{"voxel_mm", &p.voxel_mm},
-                                                       {"arch_width_mm", &p.arch_width_mm},
-                                                       {"arch_depth_mm", &p.arch_depth_mm},
-                                                       {"body_height_mm", &p.body_height_mm},
-                                                       {"body_thickness_mm", &p.body_thickness_mm},
-                                                       {"ramus_height_mm", &p.ramus_height_mm},
-                                                       {"ramus_width_mm", &p.ramus_width_mm}};
-    for (const auto& [key, field] : lengths)
-      if (auto x = m.find(key))
-        *field = positive(*x, "a length in mm, or leave it out for the variant's default");
-    if (auto x = m.find("gonial_angle_deg")) {
-      p.gonial_angle_deg = to_number(*x);
-      if (p.gonial_angle_deg <= 90 || p.gonial_angle_deg >= 180)
-        fail(x->at, x->path + " is " + fmt(p.gonial_angle_deg) +
-                        " but must lie strictly between 90 and 180 degrees; adults measure about 120");
+    // The generator's own ranges (mandible_dimensions), checked here so that a value outside is named at
+    // its line rather than as a generate option when the mandible is built.
+    const MandibleParameters defaults = mandible_defaults(p.variant);
+    for (const MandibleDimension& d : mandible_dimensions()) {
+      const auto x = m.find(d.scenario_key);
+      if (!x) continue;
+      const double value = to_number(*x);
+      if (!(value >= d.lo && value <= d.hi)) {
+        const std::string whose = d.field == &MandibleParameters::voxel_mm
+                                      ? ""
+                                      : std::string(variant_name(p.variant)) + " variant's ";
+        fail(x->at, x->path + " is " + fmt(value) + " " + d.unit +
+                        ", outside the built-in mandible's range " + fmt(d.lo) + " to " + fmt(d.hi) + " " +
+                        d.unit + "; give a value in it, or leave it out for the " + whose + "default " +
+                        fmt(defaults.*d.field) + " " + d.unit);
+      }
+      p.*d.field = value;
     }
   } else if (map.has("surface")) {
     g.source = GeometrySource::kSurface;

@@ -626,7 +626,14 @@ void ElasticitySolver::compute_reactions() {
     solution.reactions.push_back(reaction);
   }
   solution.bite_force = bite.norm();
-  const double scale = std::max(to_point(solution.applied_force).norm(), reaction_magnitudes);
+  // Issue 5's definition: |applied + all reactions| / |applied|, |applied| the norm of the net applied
+  // force. Loads that cancel leave no such scale (|applied| 0, or round-off below 1e-12 of the loads): the
+  // residual is then relative to the larger of the sum of the reaction magnitudes and the largest single
+  // load (a patch's force or the body force), and 0 when there is nothing at all.
+  double fallback = std::max(reaction_magnitudes, to_point(body_force_total).norm());
+  for (const auto& l : problem.loads) fallback = std::max(fallback, to_point(l.force).norm());
+  const double applied = to_point(solution.applied_force).norm();
+  const double scale = applied > 1e-12 * fallback ? applied : fallback;
   solution.equilibrium_residual = scale > 0.0 ? total.norm() / scale : 0.0;
 }
 

@@ -101,7 +101,8 @@ struct ElasticitySolution {
   std::vector<Vec3> vertex_displacement;
 
   // Forces and the equilibrium check. applied_force is the sum of all tractions and body forces;
-  // equilibrium_residual = |applied + sum of reactions| / max(|applied|, sum of |reaction|).
+  // equilibrium_residual = |applied + sum of reactions| / |applied| (issue 5); when the net applied force
+  // is 0, the denominator is the larger of the sum of |reaction| and the largest single load.
   Vec3 applied_force{0.0, 0.0, 0.0};
   std::vector<SupportReaction> reactions;  // one per support, in the problem's order
   double bite_force = 0.0;                 // magnitude of the summed reactions of the bite supports

@@ -385,5 +385,32 @@ TEST(CliBadInput, RepeatedExportIsAcceptedAndAnUnknownFormatNamed) {
   EXPECT_EQ(r.err.find("not in"), std::string::npos) << r.err;
 }
 
+// A mistyped command said only "A subcommand is required". Now the unknown word is named, with the
+// commands of that level and where to read about them.
+TEST(CliBadInput, MistypedCommandIsNamed) {
+  auto r = run_hexbite({"rnu", "x.yaml"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown command 'rnu'"), std::string::npos) << r.err;
+  for (const char* command : {"surface", "generate", "mesh", "run", "quality", "refine"})
+    EXPECT_NE(r.err.find(command), std::string::npos) << command << " missing in\n" << r.err;
+  EXPECT_NE(r.err.find("(hexbite --help)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("A subcommand is required"), std::string::npos) << r.err;
+
+  r = run_hexbite({"surface", "nosuch"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown command 'surface nosuch'"), std::string::npos) << r.err;
+  for (const char* command : {"check", "clean", "from-ct"})
+    EXPECT_NE(r.err.find(command), std::string::npos) << command << " missing in\n" << r.err;
+  EXPECT_NE(r.err.find("(hexbite surface --help)"), std::string::npos) << r.err;
+
+  // Options before the word do not hide it; no word at all still asks for a command.
+  r = run_hexbite({"--quiet", "mseh"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown command 'mseh'"), std::string::npos) << r.err;
+  r = run_hexbite({});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("hexbite --help"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace hexbite

@@ -330,6 +330,38 @@ TEST(ScenarioErrors, IllTypedFields) {
                   "supports[1].at must be a point");
 }
 
+// A mandible dimension outside the generator's range loaded (the loader checked only > 0, and the angle
+// against (90, 180)) and stopped generation with "--voxel 3 is outside the accepted range 0.25 to 1.5": a
+// command-line option, no file line. Now the loader checks the generator's ranges at the parameter's line,
+// with the range and the variant's default; the ends of the ranges are accepted.
+TEST(ScenarioErrors, MandibleDimensionsOutsideTheGeneratorsRange) {
+  const auto mandible = [](const std::string& keys) {
+    return replace(kValid, "mandible: {variant: dentate}", "mandible:\n    " + keys);
+  };
+  std::string m = error_of(mandible("voxel_mm: 3"));
+  EXPECT_ERROR_AT(m, 4, "geometry.mandible.voxel_mm is 3 mm");
+  EXPECT_NE(m.find("0.25 to 1.5 mm"), std::string::npos) << m;
+  EXPECT_NE(m.find("default 1 mm"), std::string::npos) << m;
+  EXPECT_EQ(m.find("--voxel"), std::string::npos) << m;
+  m = error_of(mandible("variant: edentulous\n    gonial_angle_deg: 100"));
+  EXPECT_ERROR_AT(m, 5, "geometry.mandible.gonial_angle_deg is 100 deg");
+  EXPECT_NE(m.find("105 to 140 deg"), std::string::npos) << m;
+  EXPECT_NE(m.find("default 124 deg"), std::string::npos) << m;  // the edentulous variant's
+  m = error_of(mandible("arch_width_mm: 200\n    variant: atrophic"));
+  EXPECT_ERROR_AT(m, 4, "geometry.mandible.arch_width_mm is 200 mm");
+  EXPECT_NE(m.find("75 to 120 mm"), std::string::npos) << m;
+  EXPECT_NE(m.find("default 96 mm"), std::string::npos) << m;
+  EXPECT_ERROR_AT(error_of(mandible("body_height_mm: 5")), 4, "8 to 40 mm");
+  EXPECT_ERROR_AT(error_of(mandible("ramus_width_mm: 0")), 4, "22 to 40 mm");
+  EXPECT_ERROR_AT(error_of(mandible("body_thickness_mm: -12")), 4, "8 to 20 mm");
+  // The ends of the ranges load.
+  const Scenario s =
+      load_scenario(write_scenario(mandible("{voxel_mm: 1.5, gonial_angle_deg: 105, ramus_height_mm: 75}")));
+  EXPECT_EQ(s.geometry.mandible.voxel_mm, 1.5);
+  EXPECT_EQ(s.geometry.mandible.gonial_angle_deg, 105);
+  EXPECT_EQ(s.geometry.mandible.ramus_height_mm, 75);
+}
+
 TEST(ScenarioErrors, YoungsModulusMustBePositive) {
   EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 0}\n"), 12,
                   "materials.default.E_MPa is 0 MPa but Young's modulus must be positive");
