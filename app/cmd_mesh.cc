@@ -157,6 +157,10 @@ void run_mesh(const MeshOptions& o) {
     throw InputError(
         "--fit-volume moves boundary nodes off the SURFACE, but a mesh of --quad-surface keeps that quad "
         "surface exactly as its boundary: drop --fit-volume, or mesh the triangulated SURFACE");
+  if (o.method == "sheets" && o.grid_frame == "arch")
+    throw InputError(
+        "--grid-frame arch lays the overlay grid of --method grid, but --method sheets has no grid: drop "
+        "--grid-frame, or use --method grid");
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
     return run_mesh_sheets_surface({{o.surface, o.landmarks, o.units, 0, o.output, o.json, o.refine},
                                     o.target,

@@ -14,6 +14,7 @@
 #include "common/error.h"
 #include "common/progress.h"
 #include "common/system_memory.h"
+#include "mesher/arch_frame.h"
 #include "mesher/boundary_fit.h"
 #include "mesher/ct_surface.h"
 #include "mesher/grid_mesher.h"
@@ -119,9 +120,8 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   HexMesh mesh;
   try {
     mesh = grid_mesh(geometry.surface, options, &report);
-  } catch (const InputError& e) {
-    // A bone that follows no arch is the scenario's grid_frame's fault.
-    if (!s.mesh.arch_frame) throw;
+  } catch (const NotAnArchError& e) {
+    // A bone that follows no arch is the scenario's grid_frame's fault (other input errors are not).
     throw InputError(s.mesh.grid_frame_at.str() + ": mesh.grid_frame arch: " + e.what());
   }
   if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);

@@ -1,6 +1,7 @@
 #include "common/number_format.h"
 
 #include <cstdio>
+#include <sstream>
 
 namespace hexbite {
 
@@ -11,6 +12,12 @@ std::string format_table_number(double value, int decimals, int width) {
   for (const char* c = text; *c; ++c) shows_a_digit = shows_a_digit || (*c >= '1' && *c <= '9');
   if (value != 0 && !shows_a_digit) std::snprintf(text, sizeof text, "%*.2e", width, value);
   return text;
+}
+
+std::string format_significant(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
 }
 
 }  // namespace hexbite

@@ -1,4 +1,4 @@
-// Numbers in the text tables that commands print.
+// Numbers in the text tables that commands print, and in messages.
 #pragma once
 
 #include <string>
@@ -10,5 +10,9 @@ namespace hexbite {
 // printed in scientific notation with 3 significant digits ("3.00e-07"), so that a small figure is never
 // mistaken for nothing. Not for files that programs read (results.json keeps full precision).
 std::string format_table_number(double value, int decimals, int width);
+
+// `value` as a stream prints it by default, with up to 6 significant digits: "96", "0.25", "1e+06". For
+// the numbers that a message about an input quotes back.
+std::string format_significant(double value);
 
 }  // namespace hexbite

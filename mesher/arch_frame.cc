@@ -4,10 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <string>
 
-#include "common/error.h"
+#include "mesher/units.h"
 #include "mesher/vec3.h"
 
 namespace hexbite {
@@ -24,18 +23,12 @@ constexpr int kTable = 4001;
 // The map may stretch or shrink the bone across the arch by at most this factor (1 - curvature * t).
 constexpr double kMinStretch = 0.2;
 
-std::string where(const Vec3& p) {
-  std::ostringstream out;
-  out.precision(1);
-  out << std::fixed << "(" << p[0] << ", " << p[1] << ", " << p[2] << ") mm";
-  return out.str();
-}
-
 [[noreturn]] void not_an_arch(const std::string& why) {
-  throw InputError("arch frame: " + why +
-                   "; the arch frame needs a whole mandible in the mandible frame (+x left, +y posterior, +z "
-                   "superior); use the axis-aligned grid for other solids (--grid-frame axes, in a scenario "
-                   "grid_frame: axes)");
+  throw NotAnArchError(
+      "arch frame: " + why +
+      "; the arch frame needs a whole mandible in the mandible frame (+x left, +y posterior, +z "
+      "superior); use the axis-aligned grid for other solids (--grid-frame axes, in a scenario "
+      "grid_frame: axes)");
 }
 
 }  // namespace
@@ -113,7 +106,7 @@ Vec3 ArchFrame::to_arch(const Vec3& p) const {
   const double along = dx * t.x + dy * t.y;  // 0 at the closest point; beyond an end along the straight end
   const bool before = theta == theta_lo_ && along < 0, after = theta == theta_hi_ && along > 0;
   if (!before && !after && std::fabs(along) > 1e-9 * (1 + std::hypot(dx, dy)))
-    not_an_arch("no closest point on the arch for " + where(p));
+    not_an_arch("no closest point on the arch for " + format_point_mm(p));
   const double s = before ? along : after ? length() + along : s_of_theta(theta);
   return {s, -dx * t.y + dy * t.x, p[2]};
 }
@@ -179,13 +172,13 @@ ArchFrame::ArchFrame(const TriSurface& surface) {
   const double tolerance = 1e-6 * std::max(1.0, largest_extent(surface));
   for (const Vec3& p : surface.vertices) {
     const Vec3 q = to_arch(p);
-    if (norm(sub(to_body(q), p)) > tolerance) not_an_arch("the map does not return " + where(p));
+    if (norm(sub(to_body(q), p)) > tolerance) not_an_arch("the map does not return " + format_point_mm(p));
     const double d = 1e-4;
     const Vec3 ds = sub(to_body({q[0] + d, q[1], q[2]}), to_body({q[0] - d, q[1], q[2]}));
     const Vec3 dt = sub(to_body({q[0], q[1] + d, q[2]}), to_body({q[0], q[1] - d, q[2]}));
     const double stretch = (ds[0] * dt[1] - ds[1] * dt[0]) / (4 * d * d);
     if (!(stretch > kMinStretch && stretch < 1 / kMinStretch))
-      not_an_arch("the bone at " + where(p) + " lies too far across the arch's curve (stretch " +
+      not_an_arch("the bone at " + format_point_mm(p) + " lies too far across the arch's curve (stretch " +
                   std::to_string(stretch) + ")");
   }
 }

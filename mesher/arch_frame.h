@@ -4,26 +4,36 @@
 // +z superior, mm), as `hexbite generate mandible` writes it and as the real jaw in ../shared/data/jaw is.
 // Output: the map between the body (x, y, z) and arch coordinates (s, t, z): s the arc length along the
 // arch's medial curve in the horizontal plane (from the right end), t the signed distance from that curve
-// across the bone (positive outward, buccal), z unchanged. The bone's body and rami become a straight bar,
+// across the bone (positive inward, lingual), z unchanged. The bone's body and rami become a straight bar,
 // so that an overlay grid meets their walls square instead of cutting the curved arch obliquely.
 // Algorithm: the medial curve is a polar curve rho(theta) about a point behind the bone (midway between the
 // sides, 0.3 of the bone's depth behind its back): the triangles' area-weighted mean radius in 80 angle
 // bins, fitted by a least-squares polynomial of degree 6 (Eigen); straight beyond the bone's angles. A point
 // maps to the curve's closest point (Newton steps on the angle from its own polar angle), s by a table of
 // the arc length. Hand-written: no library offers such a straightening map.
-// Cost: O(n) to fit for n triangles; O(1) per mapped point (a table search and a few Newton steps).
+// Cost: O(n) to fit for n triangles (and to check the map on every vertex); O(1) per mapped point: to_arch
+// scans every 8th tabulated point and takes a few Newton steps, to_body binary-searches the table.
 // Thread-safe after construction (const).
 #pragma once
 
 #include <vector>
 
+#include "common/error.h"
 #include "mesher/tri_surface.h"
 
 namespace hexbite {
 
+// The surface follows no arch in the mandible frame: an InputError of the frame itself, so that a caller can
+// tell it from the grid mesher's other input errors (a scenario blames its grid_frame line for this one
+// only).
+class NotAnArchError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 class ArchFrame {
  public:
-  // Fits the frame to the surface. Throws InputError when the surface does not follow an arch in the
+  // Fits the frame to the surface. Throws NotAnArchError when the surface does not follow an arch in the
   // mandible frame (points that map to no unique place along the curve, or a map that folds the bone).
   explicit ArchFrame(const TriSurface& surface);
 

@@ -21,6 +21,7 @@
 #include "mesher/hex_quality_kernel.h"
 #include "mesher/surface_projector.h"
 #include "mesher/union_find.h"
+#include "mesher/units.h"
 
 namespace hexbite {
 
@@ -35,13 +36,6 @@ using detail::sub;
 using vec3::add;
 using vec3::norm;
 using vec3::scale;
-
-std::string format_point(const Vec3& p) {
-  std::ostringstream s;
-  s.precision(1);
-  s << std::fixed << "(" << p[0] << ", " << p[1] << ", " << p[2] << ") mm";
-  return s.str();
-}
 
 // A body (an outer shell with its voids) that no grid component represents: no cell centre lies inside it
 // at this cell size.
@@ -918,7 +912,7 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
            << highs[r][2] - lows[r][2] << " mm";
       parts[r].what =
           (shells.inner[shell] ? "the whole void near " : "the whole separate shell near ") +
-          format_point(parts[r].location) + " (" + size.str() + ") lies up to " + extent.str() +
+          format_point_mm(parts[r].location) + " (" + size.str() + ") lies up to " + extent.str() +
           " mm from the mesh (" + std::to_string(parts[r].samples) + " triangles): " +
           (shells.inner[shell] ? "a void smaller than a cell is filled at this cell size"
                                : "a body smaller or thinner than a cell is not meshed at this size") +
@@ -926,8 +920,8 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
       continue;
     }
     parts[r].what = std::string(shells.inner[shell] ? "the void's surface near " : "the surface near ") +
-                    format_point(parts[r].location) + " lies up to " + extent.str() + " mm from the mesh (" +
-                    std::to_string(parts[r].samples) +
+                    format_point_mm(parts[r].location) + " lies up to " + extent.str() +
+                    " mm from the mesh (" + std::to_string(parts[r].samples) +
                     " triangles): a part too thin for this cell size; ask for more hexes to resolve it";
   }
   std::stable_sort(parts.begin(), parts.end(),
@@ -1169,7 +1163,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   }
   const TriSurface& grid_surface = arch ? straightened : surface;
   const SurfaceProjector& grid_projector = arch ? *straightened_projector : projector;
-  const Shells grid_shells = arch ? find_shells(straightened) : shells;
+  std::optional<Shells> straightened_shells;
+  if (arch) straightened_shells = find_shells(straightened);
+  const Shells& grid_shells = arch ? *straightened_shells : shells;
   const double grid_volume = arch ? enclosed_volume(straightened) : volume;
   const ArchFrame* arch_frame = arch ? &*arch : nullptr;
   double area = 0;
@@ -1343,7 +1339,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     part.location = arch ? arch->to_body(kept.dropped_centroid) : kept.dropped_centroid;
     part.samples = kept.dropped;
     part.what =
-        std::to_string(kept.dropped) + " grid cells around " + format_point(part.location) +
+        std::to_string(kept.dropped) + " grid cells around " + format_point_mm(part.location) +
         " were not face-connected to the main core and were dropped (a narrow neck at this cell size)";
     report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
   }
@@ -1358,9 +1354,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
       around += (around.empty()          ? ""
                  : b == j->bodies.back() ? " and "
                                          : ", ") +
-                format_point(scale(add(shells.body_lo[b], shells.body_hi[b]), 0.5));
+                format_point_mm(scale(add(shells.body_lo[b], shells.body_hi[b]), 0.5));
     part.what = "the separate shells of the surface around " + around + " come closer than a cell (" +
-                cell.str() + " mm) near " + format_point(part.location) +
+                cell.str() + " mm) near " + format_point_mm(part.location) +
                 ": the mesh joins them across the gap; ask for more hexes to resolve it";
     report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);
   }
@@ -1388,8 +1384,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     std::ostringstream extent;
     extent.precision(1);
     extent << std::fixed << part.extent;
-    part.what = "a separate shell of the surface around " + format_point(part.location) + " (" + size.str() +
-                ") holds no grid cell centre at this cell size (" + cell.str() +
+    part.what = "a separate shell of the surface around " + format_point_mm(part.location) + " (" +
+                size.str() + ") holds no grid cell centre at this cell size (" + cell.str() +
                 " mm) and was not meshed (it lies up to " + extent.str() +
                 " mm from the mesh): a body smaller or thinner than a cell; ask for more hexes to resolve it";
     report.fidelity.unresolved.insert(report.fidelity.unresolved.begin(), part);

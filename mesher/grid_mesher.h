@@ -108,7 +108,7 @@ struct GridMeshOptions {
   int threads = 2;
   // Lay the grid along the dental arch (mesher/arch_frame.h: the core is selected in arch coordinates and
   // mapped back before the pillow layer) instead of along the axes; for a whole mandible in the mandible
-  // frame (throws InputError for a surface that does not follow an arch).
+  // frame (throws NotAnArchError, an InputError, for a surface that does not follow an arch).
   bool arch_frame = false;
   // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass, twice,
   // with the condition stage (kappa 9.9: the kappa <= 10 with a margin; on the real jaw at 2,500

@@ -11,6 +11,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/number_format.h"
 #include "mesher/surface_projector.h"
 #include "mesher/units.h"
 
@@ -34,12 +35,6 @@ double read_number(const std::string& path, const YAML::Node& node, const std::s
   return value;
 }
 
-std::string format_general(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
 // A point in mm, each coordinate within kMaxCoordinateMm like a scenario's own (scenarios/scenario.cc), also
 // after the conversion from the file's unit.
 Vec3 read_point(const std::string& path, const YAML::Node& node, const std::string& what, double scale) {
@@ -51,9 +46,9 @@ Vec3 read_point(const std::string& path, const YAML::Node& node, const std::stri
     p[k] = scale * value;
     if (!(std::abs(p[k]) <= kMaxCoordinateMm))
       fail(path, node[k].Mark(),
-           what + " coordinate is " + format_general(p[k]) +
-               (scale == 1.0 ? "" : " mm (" + format_general(value) + " in the file's unit)") + ", beyond " +
-               format_general(kMaxCoordinateMm) +
+           what + " coordinate is " + format_significant(p[k]) +
+               (scale == 1.0 ? "" : " mm (" + format_significant(value) + " in the file's unit)") +
+               ", beyond " + format_significant(kMaxCoordinateMm) +
                " mm in size; give the coordinates in the frame and unit of the surface (a mandible spans "
                "about 100 mm)");
   }
@@ -82,8 +77,8 @@ void read_muscle(const std::string& path, const YAML::Node& node, double scale, 
       if (m.max_force_N < 0) fail(path, kv.second.Mark(), muscle + "max_force_N must not be negative");
       if (m.max_force_N > kMaxMuscleForceN)
         fail(path, kv.second.Mark(),
-             muscle + "max_force_N is " + format_general(m.max_force_N) + " N, more than " +
-                 format_general(kMaxMuscleForceN) +
+             muscle + "max_force_N is " + format_significant(m.max_force_N) + " N, more than " +
+                 format_significant(kMaxMuscleForceN) +
                  " N; no jaw muscle comes near (the superficial masseter gives about 190 N): give the force "
                  "in newtons");
       has[1] = true;

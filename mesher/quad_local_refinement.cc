@@ -9,6 +9,7 @@
 #include "common/progress.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_placement.h"
+#include "mesher/units.h"
 #include "mesher/vec3.h"
 
 namespace hexbite {
@@ -33,12 +34,6 @@ Vec3 centroid(const QuadSurface& s, const std::array<int, 4>& quad) {
 std::string mm(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f mm", x);
-  return buf;
-}
-
-std::string point_text(const Vec3& p) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
   return buf;
 }
 
@@ -233,7 +228,7 @@ QuadSurface refine_quads_locally(const QuadSurface& quads, const SurfaceProjecto
     if (on.distance > o.max_point_distance_mm)
       throw LocalRefinementError(
           name + " is " + mm(on.distance) + " from the surface (nearest surface point " +
-          point_text(on.point) + "); at most " + mm(o.max_point_distance_mm) +
+          format_point_mm(on.point) + "); at most " + mm(o.max_point_distance_mm) +
           " is allowed: give a point on the bone surface, such as a bite-point landmark");
     LocalRefinementSite site;
     site.point = o.points[i];

@@ -18,6 +18,7 @@
 #include "mesher/quad_local_refinement.h"
 #include "mesher/surface_projector.h"
 #include "mesher/thin_plate_spline.h"
+#include "mesher/units.h"
 #include "mesher/vec3.h"
 
 namespace hexbite {
@@ -1288,12 +1289,6 @@ void refine_for_fidelity(QuadSurface& fine, const PlacementSurface& s, std::vect
   report->fidelity_quads_added = static_cast<int>(fine.quads.size()) - quads_before;
 }
 
-std::string point_text(const Vec3& p) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
-  return buf;
-}
-
 }  // namespace
 
 int quads_for_target_hexes(long target_hexes) {
@@ -1475,8 +1470,8 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
     std::snprintf(buf, sizeof buf, "%.1f mm", report.hausdorff_mm);
     throw InputError(
         std::string("the surface does not fit the mandible template: the placed quad surface is ") + buf +
-        (missed ? " away from the surface at " + point_text(worst_surface)
-                : " off the surface at " + point_text(worst_quad)) +
+        (missed ? " away from the surface at " + format_point_mm(worst_surface)
+                : " off the surface at " + format_point_mm(worst_quad)) +
         " (limit " + std::to_string(static_cast<int>(options.max_hausdorff_mm)) +
         " mm). The surface must be a whole mandible in the generator's frame (+x subject's left, "
         "+y posterior, +z superior, mm)" +

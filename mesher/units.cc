@@ -28,4 +28,10 @@ std::string implausible_size_warning(double largest_extent_mm, const std::string
   return {};
 }
 
+std::string format_point_mm(const Vec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
+  return buf;
+}
+
 }  // namespace hexbite

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "mesher/tri_surface.h"
+
 namespace hexbite {
 
 // The largest coordinate (or vector component) accepted from a scenario or landmark file, in mm: a mandible
@@ -19,5 +21,8 @@ double unit_to_mm(const std::string& unit);
 // in metres and read as mm; `fix` says how to give the unit) or over 3000 mm (micrometres).
 // Empty for plausible sizes.
 std::string implausible_size_warning(double largest_extent_mm, const std::string& fix);
+
+// A point in millimetres for a message, to a tenth of a millimetre: "(12.3, -4.0, 56.7) mm".
+std::string format_point_mm(const Vec3& p);
 
 }  // namespace hexbite

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "common/number_format.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/quad_local_refinement.h"
 #include "mesher/units.h"
@@ -43,9 +44,7 @@ std::string quote(const std::string& s) {
 }
 
 std::string fmt(double x) {
-  std::ostringstream out;
-  out << x;
-  return out.str();
+  return format_significant(x);
 }
 
 std::string fmt(const Vec3& p) {

@@ -102,7 +102,8 @@ struct ElasticitySolution {
 
   // Forces and the equilibrium check. applied_force is the sum of all tractions and body forces;
   // equilibrium_residual = |applied + sum of reactions| / |applied| (issue 5); when the net applied force
-  // is 0, the denominator is the larger of the sum of |reaction| and the largest single load.
+  // is 0 (or below 1e-12 of that fallback: loads that cancel), the denominator is the larger of the sum of
+  // |reaction| and the largest single load.
   Vec3 applied_force{0.0, 0.0, 0.0};
   std::vector<SupportReaction> reactions;  // one per support, in the problem's order
   double bite_force = 0.0;                 // magnitude of the summed reactions of the bite supports

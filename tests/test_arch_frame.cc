@@ -100,6 +100,19 @@ TEST(ArchFrame, MeshCommandRefusesANonArchWithExitCode2) {
   EXPECT_NE(bad.err.find("--grid-frame"), std::string::npos) << bad.err;
 }
 
+// --method sheets lays no grid: --grid-frame arch with it is refused (like a scenario's grid_frame), not
+// ignored.
+TEST(ArchFrame, MeshCommandRefusesTheArchFrameForTheSheetsMethod) {
+  const std::string dir = test::temp_dir();
+  write_surface(dir + "/torus.stl", torus());
+  const test::CommandResult r = test::run_hexbite(
+      {"mesh", dir + "/torus.stl", "--method", "sheets", "--grid-frame", "arch", "-o", dir + "/t.vtu"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--grid-frame arch lays the overlay grid of --method grid"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::ifstream(dir + "/t.vtu").good());
+}
+
 // The axis-aligned grid cuts the curved arch obliquely; along the arch the built-in mandible's mean scaled
 // Jacobian at 2,500 hexes rises from 0.792 (docs/meshing.md) to 0.822, with every boundary node on the
 // surface.
