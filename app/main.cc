@@ -112,8 +112,13 @@ std::optional<std::string> missing_command_message(const CLI::App& app) {
        level->get_subcommands([](const CLI::App* a) { return !a->get_group().empty(); }))
     commands += (commands.empty() ? "" : ", ") + sub->get_name();
   const std::string list = "the " + chosen + "commands are: " + commands + " (hexbite " + chosen + "--help)";
-  for (const std::string& word : app.remaining(true))
-    if (!word.empty() && word[0] != '-') return "unknown command '" + chosen + word + "'; " + list;
+  // The first word left over decides: an option there belongs to a command not given (`hexbite surface
+  // --units m`: 'm' is its value, not a command), a plain word is a mistyped command.
+  for (const std::string& word : app.remaining(true)) {
+    if (word.empty()) continue;
+    if (word[0] == '-') return "a command is required before '" + word + "'; " + list;
+    return "unknown command '" + chosen + word + "'; " + list;
+  }
   return "a command is required; " + list;
 }
 

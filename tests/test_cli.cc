@@ -410,6 +410,11 @@ TEST(CliBadInput, MistypedCommandIsNamed) {
   r = run_hexbite({});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("hexbite --help"), std::string::npos) << r.err;
+  // An option where the command should be: its value is no command.
+  r = run_hexbite({"surface", "--units", "m"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("a command is required before '--units'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("unknown command"), std::string::npos) << r.err;
 }
 
 }  // namespace
