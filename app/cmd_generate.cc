@@ -5,7 +5,10 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <limits>
+#include <map>
+#include <string>
 
 #include "app/commands.h"
 #include "app/option_checks.h"
@@ -94,6 +97,49 @@ void run_generate(const GenerateArgs& args) {
   info("wrote " + args.output + ", " + landmark_path + (args.ct.empty() ? "" : ", " + args.ct));
 }
 
+// What each dimension of mandible_dimensions() is, by its option name; a row added to that table without
+// a meaning here shows its option name ("ramus-width").
+std::string dimension_meaning(const std::string& option) {
+  static const std::map<std::string, std::string> meaning = {
+      {"voxel", "Voxel size of the CT-like grid"},
+      {"arch-width", "Bigonial width"},
+      {"arch-depth", "Symphysis to gonion along y"},
+      {"body-height", "Body height at the first molar"},
+      {"body-thickness", "Body thickness at the first molar"},
+      {"ramus-height", "Gonion to condylion"},
+      {"ramus-width", "Minimum ramus breadth"},
+      {"gonial-angle", "Gonial angle"}};
+  const auto it = meaning.find(option);
+  return it == meaning.end() ? option : it->second;
+}
+
+// "Body height at the first molar in mm, 8 to 40 (default: dentate 27, edentulous 21, atrophic 12)": the
+// range and the defaults from the generator's one table (mandible_dimensions, mandible_defaults); one
+// default when the variants share it.
+std::string dimension_help(const MandibleDimension& dim) {
+  const bool degrees = std::string(dim.unit) == "deg";
+  std::string help = dimension_meaning(dim.option) + (degrees ? " in degrees" : " in mm");
+  char buf[160];
+  std::snprintf(buf, sizeof buf, ", %g to %g (default: ", dim.lo, dim.hi);
+  help += buf;
+  const MandibleVariant variants[] = {MandibleVariant::kDentate, MandibleVariant::kEdentulous,
+                                      MandibleVariant::kAtrophic};
+  const double first = mandible_defaults(variants[0]).*dim.field;
+  const bool same = std::all_of(std::begin(variants), std::end(variants),
+                                [&](MandibleVariant v) { return mandible_defaults(v).*dim.field == first; });
+  for (const MandibleVariant v : variants) {
+    if (same) {
+      std::snprintf(buf, sizeof buf, "%g", first);
+    } else {
+      std::snprintf(buf, sizeof buf, "%s%s %g", v == variants[0] ? "" : ", ", variant_name(v),
+                    mandible_defaults(v).*dim.field);
+    }
+    help += buf;
+    if (same) break;
+  }
+  return help + ")";
+}
+
 }  // namespace
 
 void add_generate_commands(CLI::App& app) {
@@ -112,17 +158,10 @@ void add_generate_commands(CLI::App& app) {
   cmd->add_option("--ct", args->ct, "Also write the CT-like volume (.mha, .mhd, .nii, .nii.gz)")
       ->check(output_file({".mha", ".mhd", ".nii", ".nii.gz"}));
   cmd->add_option("--variant", args->variant, "dentate, edentulous or atrophic (resorbed, low body)");
-  cmd->add_option("--voxel", p.voxel_mm, "Voxel size of the CT-like grid in mm (0.25 to 1.5)");
-  const char* zero = " (default: the variant's, see docs/mandible.md)";
-  cmd->add_option("--arch-width", p.arch_width_mm, std::string("Bigonial width in mm") + zero);
-  cmd->add_option("--arch-depth", p.arch_depth_mm, std::string("Symphysis to gonion along y in mm") + zero);
-  cmd->add_option("--body-height", p.body_height_mm,
-                  std::string("Body height at the first molar in mm") + zero);
-  cmd->add_option("--body-thickness", p.body_thickness_mm,
-                  std::string("Body thickness at the first molar in mm") + zero);
-  cmd->add_option("--ramus-height", p.ramus_height_mm, std::string("Gonion to condylion in mm") + zero);
-  cmd->add_option("--ramus-width", p.ramus_width_mm, std::string("Minimum ramus breadth in mm") + zero);
-  cmd->add_option("--gonial-angle", p.gonial_angle_deg, std::string("Gonial angle in degrees") + zero);
+  // One option per row of the generator's table of dimensions, its range and the variants' defaults
+  // printed from that table, so that the help cannot drift from what the generator accepts.
+  for (const MandibleDimension& dim : mandible_dimensions())
+    cmd->add_option(std::string("--") + dim.option, p.*dim.field, dimension_help(dim));
   cmd->callback([args] { run_generate(*args); });
 }
 

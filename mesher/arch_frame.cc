@@ -112,12 +112,31 @@ Vec3 ArchFrame::to_arch(const Vec3& p) const {
 }
 
 ArchFrame::ArchFrame(const TriSurface& surface) {
+  // A sharply bent arch (a narrow or deep arch, a gonial angle near 105 degrees, a jaw turned 20 degrees
+  // about z) squeezes the tops of the rami across a curve fitted about a centre close behind the bone;
+  // a centre further back bends the curve's ends less. The first centre whose map passes the checks
+  // wins; if none does, the first one's reason is reported. Far behind, a ring's curve passes the checks
+  // below through its hole, hence the further check of the fallback: the curve runs inside the bone.
+  constexpr double kBack[] = {0.3, 1.0};
+  std::string first_reason;
+  for (const double back : kBack) {
+    try {
+      fit(surface, back, back != kBack[0]);
+      return;
+    } catch (const NotAnArchError& e) {
+      if (first_reason.empty()) first_reason = e.what();
+    }
+  }
+  throw NotAnArchError(first_reason);
+}
+
+void ArchFrame::fit(const TriSurface& surface, double back, bool curve_inside) {
   if (surface.triangles.empty()) not_an_arch("the surface has no triangles");
   Vec3 lo = surface.vertices.front(), hi = lo;
   for (const Vec3& p : surface.vertices)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
   ox_ = 0.5 * (lo[0] + hi[0]);
-  oy_ = hi[1] + 0.3 * (hi[1] - lo[1]);
+  oy_ = hi[1] + back * (hi[1] - lo[1]);
   double a0 = M_PI, a1 = -M_PI;
   for (const Vec3& p : surface.vertices) {
     const double a = std::atan2(p[0] - ox_, oy_ - p[1]);
@@ -165,7 +184,48 @@ ArchFrame::ArchFrame(const TriSurface& surface) {
     x_[i] = q.x;
     y_[i] = q.y;
     s_[i] = i > 0 ? s_[i - 1] + std::hypot(q.x - x_[i - 1], q.y - y_[i - 1]) : 0.0;
-    if (rho(theta_[i]) <= 0) not_an_arch("the fitted arch passes behind the bone");
+    if (rho(theta_[i]) <= 0)
+      not_an_arch(
+          "the fitted arch passes behind the bone (is the chin towards +y? the frame needs it towards -y)");
+  }
+
+  // When asked, the curve must run inside the bone seen from above (a ring's curve runs through its hole):
+  // the triangles' shadow on a raster of 1/200 of the bone's size covers every tabulated point within the
+  // bone's angles but a quarter (the curve's ends may pass beside a ramus or a condyle).
+  if (curve_inside) {
+    const double h = std::max(hi[0] - lo[0], hi[1] - lo[1]) / 200;
+    const int nx = int((hi[0] - lo[0]) / h) + 3, ny = int((hi[1] - lo[1]) / h) + 3;
+    std::vector<char> shadow(std::size_t(nx) * ny, 0);
+    for (const auto& tri : surface.triangles) {
+      const Vec3 &a = surface.vertices[tri[0]], &b = surface.vertices[tri[1]], &c = surface.vertices[tri[2]];
+      const double area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+      const int i0 = int((std::min({a[0], b[0], c[0]}) - lo[0]) / h) + 1,
+                i1 = int((std::max({a[0], b[0], c[0]}) - lo[0]) / h) + 1;
+      const int j0 = int((std::min({a[1], b[1], c[1]}) - lo[1]) / h) + 1,
+                j1 = int((std::max({a[1], b[1], c[1]}) - lo[1]) / h) + 1;
+      for (int i = i0; i <= i1; ++i)
+        for (int j = j0; j <= j1; ++j) {
+          if (std::fabs(area2) < 1e-300) {
+            shadow[std::size_t(j) * nx + i] = 1;
+            continue;
+          }
+          const double x = lo[0] + (i - 0.5) * h, y = lo[1] + (j - 0.5) * h;
+          const double u = ((b[0] - x) * (c[1] - y) - (b[1] - y) * (c[0] - x)) / area2;
+          const double v = ((c[0] - x) * (a[1] - y) - (c[1] - y) * (a[0] - x)) / area2;
+          const double w = 1 - u - v, e = 0.5;  // generous: half the triangle's size beyond it counts
+          if (u >= -e && v >= -e && w >= -e) shadow[std::size_t(j) * nx + i] = 1;
+        }
+    }
+    int inside = 0, outside = 0;
+    for (int k = 0; k < kTable; k += 8) {
+      if (theta_[k] < a0 || theta_[k] > a1) continue;
+      const int i = int((x_[k] - lo[0]) / h) + 1, j = int((y_[k] - lo[1]) / h) + 1;
+      const bool in = i >= 0 && j >= 0 && i < nx && j < ny && shadow[std::size_t(j) * nx + i];
+      (in ? inside : outside)++;
+    }
+    if (outside > 0.25 * (inside + outside))
+      not_an_arch("the arch's curve runs outside the bone seen from above (through a hole?) at " +
+                  std::to_string(int(100.0 * outside / (inside + outside))) + " % of its length");
   }
 
   // Every point of the surface must map back to itself, where the map neither folds nor squeezes the bone.

@@ -7,7 +7,8 @@
 // across the bone (positive inward, lingual), z unchanged. The bone's body and rami become a straight bar,
 // so that an overlay grid meets their walls square instead of cutting the curved arch obliquely.
 // Algorithm: the medial curve is a polar curve rho(theta) about a point behind the bone (midway between the
-// sides, 0.3 of the bone's depth behind its back): the triangles' area-weighted mean radius in 80 angle
+// sides, 0.3 of the bone's depth behind its back; 1.0 when that map fails its checks, as for a narrow or a
+// deep arch): the triangles' area-weighted mean radius in 80 angle
 // bins, fitted by a least-squares polynomial of degree 6 (Eigen); straight beyond the bone's angles. A point
 // maps to the curve's closest point (Newton steps on the angle from its own polar angle), s by a table of
 // the arc length. Hand-written: no library offers such a straightening map.
@@ -42,6 +43,10 @@ class ArchFrame {
   double length() const { return s_.back(); }  // arc length of the tabulated curve, mm
 
  private:
+  // Fits the curve about a polar centre `back` times the bone's depth behind its back, checking that the
+  // curve runs inside the bone seen from above when `curve_inside`; throws NotAnArchError.
+  void fit(const TriSurface& surface, double back, bool curve_inside);
+
   struct Point2 {
     double x, y;
   };
