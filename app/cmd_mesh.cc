@@ -203,8 +203,10 @@ void run_mesh(const MeshOptions& o) {
                 << " inverted hexes on purpose (--allow-invalid): " << list << '\n';
       return;
     }
-    throw RunError(std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " +
-                   list + "; no mesh written (--allow-invalid writes it anyway)");
+    throw RunError(
+        std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " + list +
+        "; no mesh written (--allow-invalid writes it anyway" +
+        (options.arch_frame ? "; the axis-aligned grid, --grid-frame axes, may mesh it valid)" : ")"));
   }
   if (!o.json) info("wrote " + o.output);
 }

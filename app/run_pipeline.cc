@@ -131,7 +131,8 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   if (report.optimize.inverted > 0)
     throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
-                   "; try another target (hexbite mesh shows where)");
+                   "; try another target" + (s.mesh.arch_frame ? " or grid_frame: axes" : "") +
+                   " (hexbite mesh shows where)");
   return mesh;
 }
 
