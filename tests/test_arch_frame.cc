@@ -116,19 +116,8 @@ TEST(ArchFrame, MeshCommandRefusesTheArchFrameForTheSheetsMethod) {
 // Two boxes side by side pass the frame's checks but keep inverted hexes along the arch: the failure (exit
 // 1) points to the axis-aligned grid.
 TEST(ArchFrame, InvertedHexesAlongTheArchPointToTheAxes) {
-  std::string obj;
-  const int faces[12][3] = {{1, 3, 4}, {1, 4, 2}, {5, 6, 8}, {5, 8, 7}, {1, 2, 6}, {1, 6, 5},
-                            {3, 7, 8}, {3, 8, 4}, {1, 5, 7}, {1, 7, 3}, {2, 4, 8}, {2, 8, 6}};
-  for (int box = 0; box < 2; ++box) {
-    for (int v = 0; v < 8; ++v)
-      obj += "v " + std::to_string(40 * box + 20 * (v & 1)) + " " + std::to_string(20 * ((v >> 1) & 1)) +
-             " " + std::to_string(20 * ((v >> 2) & 1)) + "\n";
-    for (const auto& f : faces)
-      obj += "f " + std::to_string(f[0] + 8 * box) + " " + std::to_string(f[1] + 8 * box) + " " +
-             std::to_string(f[2] + 8 * box) + "\n";
-  }
   const std::string dir = test::temp_dir();
-  test::write_file(dir + "/boxes.obj", obj);
+  test::write_file(dir + "/boxes.obj", test::cubes_obj(2));
   const test::CommandResult r = test::run_hexbite(
       {"mesh", dir + "/boxes.obj", "--grid-frame", "arch", "--target-hexes", "800", "-o", dir + "/b.vtu"});
   EXPECT_EQ(r.exit_code, 1) << r.err;

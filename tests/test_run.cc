@@ -403,22 +403,6 @@ TEST(RunScenario, MaterialRegionHoldingNoHexIsRefusedAtItsLine) {
   EXPECT_NE(err.find("mm outside it: move it into the bone or enlarge it"), std::string::npos) << err;
 }
 
-// Separate 20 mm cubes (x 0-20, 40-60, ...) as OBJ text, outward triangles.
-std::string cubes_obj(int cubes) {
-  std::string text;
-  const int faces[12][3] = {{1, 3, 4}, {1, 4, 2}, {5, 6, 8}, {5, 8, 7}, {1, 2, 6}, {1, 6, 5},
-                            {3, 7, 8}, {3, 8, 4}, {1, 5, 7}, {1, 7, 3}, {2, 4, 8}, {2, 8, 6}};
-  for (int cube = 0; cube < cubes; ++cube) {
-    for (int v = 0; v < 8; ++v)
-      text += "v " + std::to_string(40 * cube + 20 * (v & 1)) + " " + std::to_string(20 * ((v >> 1) & 1)) +
-              " " + std::to_string(20 * ((v >> 2) & 1)) + "\n";
-    for (const auto& f : faces)
-      text += "f " + std::to_string(f[0] + 8 * cube) + " " + std::to_string(f[1] + 8 * cube) + " " +
-              std::to_string(f[2] + 8 * cube) + "\n";
-  }
-  return text;
-}
-
 // A geometry of two separate bodies (the fragments of a fractured mandible, say) with supports on one only:
 // the other could move freely. Refused before the solve, naming that body; before, the solve ran and
 // failed its equilibrium check with displacements of 1e12 mm and the advice to tighten the tolerance.
@@ -434,7 +418,7 @@ supports:
 outputs: {bite_force: false}
 )";
   const std::string path = write_scenario(scenario);
-  test::write_file(fs::path(path).parent_path().string() + "/two_cubes.obj", cubes_obj(2));
+  test::write_file(fs::path(path).parent_path().string() + "/two_cubes.obj", test::cubes_obj(2));
   const std::string dir = test::temp_dir() + "/out";
   test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
   EXPECT_EQ(r.exit_code, 2) << r.err;
@@ -470,7 +454,7 @@ supports:
   - {name: base, at: [0, 10, 10], radius_mm: 5}
 outputs: {bite_force: false}
 )");
-  test::write_file(fs::path(path).parent_path().string() + "/cube.obj", cubes_obj(1));
+  test::write_file(fs::path(path).parent_path().string() + "/cube.obj", test::cubes_obj(1));
   const std::string dir = test::temp_dir() + "/out";
   const test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
   EXPECT_EQ(r.exit_code, 2) << r.err;

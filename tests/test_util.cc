@@ -82,4 +82,19 @@ std::string shared_data(const std::string& relative) {
   return path;
 }
 
+std::string cubes_obj(int cubes) {
+  std::string text;
+  const int faces[12][3] = {{1, 3, 4}, {1, 4, 2}, {5, 6, 8}, {5, 8, 7}, {1, 2, 6}, {1, 6, 5},
+                            {3, 7, 8}, {3, 8, 4}, {1, 5, 7}, {1, 7, 3}, {2, 4, 8}, {2, 8, 6}};
+  for (int cube = 0; cube < cubes; ++cube) {
+    for (int v = 0; v < 8; ++v)
+      text += "v " + std::to_string(40 * cube + 20 * (v & 1)) + " " + std::to_string(20 * ((v >> 1) & 1)) +
+              " " + std::to_string(20 * ((v >> 2) & 1)) + "\n";
+    for (const auto& f : faces)
+      text += "f " + std::to_string(f[0] + 8 * cube) + " " + std::to_string(f[1] + 8 * cube) + " " +
+              std::to_string(f[2] + 8 * cube) + "\n";
+  }
+  return text;
+}
+
 }  // namespace hexbite::test

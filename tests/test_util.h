@@ -29,6 +29,9 @@ std::string shared_data(const std::string& relative);
 std::string read_file(const std::string& path);
 void write_file(const std::string& path, const std::string& contents);
 
+// Separate 20 mm cubes (x 0-20, 40-60, ...) as OBJ text, outward triangles.
+std::string cubes_obj(int cubes);
+
 // The message of the exception of type E that f() throws; a test failure, and "", when it throws none.
 template <class E, class F>
 std::string message_of(F f) {
