@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <iterator>
 #include <limits>
-#include <map>
 #include <string>
 
 #include "app/commands.h"
@@ -97,28 +96,12 @@ void run_generate(const GenerateArgs& args) {
   info("wrote " + args.output + ", " + landmark_path + (args.ct.empty() ? "" : ", " + args.ct));
 }
 
-// What each dimension of mandible_dimensions() is, by its option name; a row added to that table without
-// a meaning here shows its option name ("ramus-width").
-std::string dimension_meaning(const std::string& option) {
-  static const std::map<std::string, std::string> meaning = {
-      {"voxel", "Voxel size of the CT-like grid"},
-      {"arch-width", "Bigonial width"},
-      {"arch-depth", "Symphysis to gonion along y"},
-      {"body-height", "Body height at the first molar"},
-      {"body-thickness", "Body thickness at the first molar"},
-      {"ramus-height", "Gonion to condylion"},
-      {"ramus-width", "Minimum ramus breadth"},
-      {"gonial-angle", "Gonial angle"}};
-  const auto it = meaning.find(option);
-  return it == meaning.end() ? option : it->second;
-}
-
 // "Body height at the first molar in mm, 8 to 40 (default: dentate 27, edentulous 21, atrophic 12)": the
 // range and the defaults from the generator's one table (mandible_dimensions, mandible_defaults); one
 // default when the variants share it.
 std::string dimension_help(const MandibleDimension& dim) {
   const bool degrees = std::string(dim.unit) == "deg";
-  std::string help = dimension_meaning(dim.option) + (degrees ? " in degrees" : " in mm");
+  std::string help = std::string(dim.meaning) + (degrees ? " in degrees" : " in mm");
   char buf[160];
   std::snprintf(buf, sizeof buf, ", %g to %g (default: ", dim.lo, dim.hi);
   help += buf;

@@ -598,14 +598,15 @@ const std::vector<MandibleDimension>& mandible_dimensions() {
   // 6.5 mm ramus plate, the atrophic ridge) at least four voxels across.
   using P = MandibleParameters;
   static const std::vector<MandibleDimension> dimensions = {
-      {"voxel", "voxel_mm", "mm", &P::voxel_mm, 0.25, 1.5},
-      {"arch-width", "arch_width_mm", "mm", &P::arch_width_mm, 75, 120},
-      {"arch-depth", "arch_depth_mm", "mm", &P::arch_depth_mm, 40, 75},
-      {"body-height", "body_height_mm", "mm", &P::body_height_mm, 8, 40},
-      {"body-thickness", "body_thickness_mm", "mm", &P::body_thickness_mm, 8, 20},
-      {"ramus-height", "ramus_height_mm", "mm", &P::ramus_height_mm, 40, 75},
-      {"ramus-width", "ramus_width_mm", "mm", &P::ramus_width_mm, 22, 40},
-      {"gonial-angle", "gonial_angle_deg", "deg", &P::gonial_angle_deg, 105, 140}};
+      {"voxel", "voxel_mm", "Voxel size of the CT-like grid", "mm", &P::voxel_mm, 0.25, 1.5},
+      {"arch-width", "arch_width_mm", "Bigonial width", "mm", &P::arch_width_mm, 75, 120},
+      {"arch-depth", "arch_depth_mm", "Symphysis to gonion along y", "mm", &P::arch_depth_mm, 40, 75},
+      {"body-height", "body_height_mm", "Body height at the first molar", "mm", &P::body_height_mm, 8, 40},
+      {"body-thickness", "body_thickness_mm", "Body thickness at the first molar", "mm",
+       &P::body_thickness_mm, 8, 20},
+      {"ramus-height", "ramus_height_mm", "Gonion to condylion", "mm", &P::ramus_height_mm, 40, 75},
+      {"ramus-width", "ramus_width_mm", "Minimum ramus breadth", "mm", &P::ramus_width_mm, 22, 40},
+      {"gonial-angle", "gonial_angle_deg", "Gonial angle", "deg", &P::gonial_angle_deg, 105, 140}};
   return dimensions;
 }
 

@@ -33,6 +33,7 @@ struct MandibleParameters {
 struct MandibleDimension {
   const char* option;        // the generate option without its dashes: "arch-width"
   const char* scenario_key;  // the key under a scenario's geometry.mandible: "arch_width_mm"
+  const char* meaning;       // for help texts: "Bigonial width"
   const char* unit;          // "mm" or "deg"
   double MandibleParameters::*field;
   double lo, hi;  // accepted: lo <= value <= hi
