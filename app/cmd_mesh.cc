@@ -107,10 +107,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   if (r.volume_fit) out << "volume fit: " << describe(*r.volume_fit) << '\n';
   if (!f.unresolved.empty()) {
     out << "not resolved at this size (" << f.unresolved.size() << " regions):\n";
-    const std::size_t shown = std::min<std::size_t>(f.unresolved.size(), 10);
-    for (std::size_t i = 0; i < shown; ++i) out << "  " << f.unresolved[i].what << '\n';
-    if (shown < f.unresolved.size())
-      out << "  ... and " << f.unresolved.size() - shown << " smaller regions\n";
+    for (const std::string& line : unresolved_listing(f.unresolved)) out << "  " << line << '\n';
   }
   return out.str();
 }

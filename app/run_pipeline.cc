@@ -127,7 +127,9 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
-  for (const UnresolvedPart& part : report.fidelity.unresolved) info("not resolved: " + part.what);
+  // The first ten; results.json lists every one (mesh.fidelity.unresolved).
+  for (const std::string& line : unresolved_listing(report.fidelity.unresolved))
+    info("not resolved: " + line);
   if (report.optimize.inverted > 0)
     throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +

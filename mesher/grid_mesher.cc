@@ -931,6 +931,14 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
 
 }  // namespace
 
+std::vector<std::string> unresolved_listing(const std::vector<UnresolvedPart>& parts, std::size_t shown) {
+  std::vector<std::string> lines;
+  for (std::size_t i = 0; i < parts.size() && i < shown; ++i) lines.push_back(parts[i].what);
+  if (parts.size() > shown)
+    lines.push_back("... and " + std::to_string(parts.size() - shown) + " smaller regions");
+  return lines;
+}
+
 void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPart>& parts) {
   for (UnresolvedPart& part : parts) {
     // The nearest of each kind; ties go to the first in the file's order (points are ordered by name).

@@ -187,6 +187,11 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options,
 // there is one): fills `near` and starts `what` with "near left_coronoid_tip (3.2 mm), ...: ".
 void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPart>& parts);
 
+// What `hexbite mesh` and `hexbite run` print of the parts: the sentences of the first `shown` (dropped or
+// joined bodies first, then the regions farthest from the mesh), and for the rest one line "... and N
+// smaller regions". The full list is in the commands' JSON.
+std::vector<std::string> unresolved_listing(const std::vector<UnresolvedPart>& parts, std::size_t shown = 10);
+
 // Volume of a hex mesh with trilinear hexes (2 x 2 x 2 Gauss points, exact for trilinear maps).
 double hex_mesh_volume(const HexMesh& mesh);
 

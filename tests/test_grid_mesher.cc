@@ -505,6 +505,22 @@ TEST(GridMesher, NamesUnresolvedPartsByTheNearestLandmark) {
             "near left_middle_temporalis.insertion (1.0 mm), left_coronoid_tip (3.0 mm): " + part.what);
 }
 
+// `hexbite run` on the real jaw at 4,000 hexes printed all 32 regions (its crowns: 1.3-1.7 mm under 4 mm
+// cells), burying the table; it now shows ten like `hexbite mesh` and counts the rest.
+TEST(GridMesher, UnresolvedListingShowsTheFirstPartsAndCountsTheRest) {
+  std::vector<UnresolvedPart> parts(12);
+  for (int i = 0; i < 12; ++i) parts[i].what = "part " + std::to_string(i);
+  const std::vector<std::string> lines = unresolved_listing(parts);
+  ASSERT_EQ(lines.size(), 11u);
+  EXPECT_EQ(lines[0], "part 0");
+  EXPECT_EQ(lines[9], "part 9");
+  EXPECT_EQ(lines[10], "... and 2 smaller regions");
+  parts.resize(10);
+  EXPECT_EQ(unresolved_listing(parts).size(), 10u);
+  EXPECT_EQ(unresolved_listing(parts, 3).back(), "... and 7 smaller regions");
+  EXPECT_TRUE(unresolved_listing({}).empty());
+}
+
 // "Thin parts that the requested size cannot resolve are reported by name and location": the built-in
 // mandible at 1,000 hexes (cells of 7.0 mm) loses the tips of its coronoid processes (regions up to 4.6 mm
 // from the mesh, centred 1.5 and 1.6 mm from the tips, measured), and `hexbite mesh --landmarks` names them,
