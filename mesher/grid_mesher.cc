@@ -1214,9 +1214,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   // thick-margin core (thin plates keep their cells) on the half- and the quarter-shifted grid: the plain
   // core gave the better means and minima on the built-in mandible, the thick margin the real jaw's better
   // minima at 30,000-50,000 hexes and its coronoid tips, and which grid position wins varies with the size
-  // (docs/meshing.md); four attempts take two rounds in two threads, as three did. Attempts 0 and 1 are the
-  // same either way; attempt 0's core (the calling thread computes it first) decides whether the cells are
-  // fine.
+  // (docs/meshing_experiments.md); four attempts take two rounds in two threads, as three did. Attempts 0
+  // and 1 are the same either way; attempt 0's core (the calling thread computes it first) decides whether
+  // the cells are fine.
   struct Job {
     double shift;
     CoreRule rule;
