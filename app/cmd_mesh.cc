@@ -47,6 +47,7 @@ struct MeshOptions {
   bool allow_invalid = false;
   bool fit_volume = false;
   std::string grid_frame = "axes";  // --method grid: axes or arch (mesher/arch_frame.h)
+  bool grid_frame_given = false;    // --grid-frame on the command line (refused with --method sheets)
   double margin = GridMeshOptions{}.margin;
   bool margin_given = false;        // --margin on the command line: that margin everywhere, on three grids
   std::string quad_surface;         // --method sheets
@@ -154,10 +155,19 @@ void run_mesh(const MeshOptions& o) {
     throw InputError(
         "--fit-volume moves boundary nodes off the SURFACE, but a mesh of --quad-surface keeps that quad "
         "surface exactly as its boundary: drop --fit-volume, or mesh the triangulated SURFACE");
-  if (o.method == "sheets" && o.grid_frame == "arch")
-    throw InputError(
-        "--grid-frame arch lays the overlay grid of --method grid, but --method sheets has no grid: drop "
-        "--grid-frame, or use --method grid");
+  // --method sheets lays no overlay grid: the grid's options are refused rather than ignored.
+  struct GridOption {
+    bool given;
+    std::string name, value, what;
+  };
+  for (const GridOption& g :
+       {GridOption{o.grid_frame_given, "--grid-frame", o.grid_frame, "lays the overlay grid"},
+        GridOption{o.margin_given, "--margin", fmt("%g", o.margin),
+                   "chooses the core cells of the overlay grid"}})
+    if (g.given && o.method == "sheets")
+      throw InputError(g.name + " " + g.value + " " + g.what +
+                       " of --method grid, but --method sheets has no grid: drop " + g.name +
+                       ", or use --method grid");
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
     return run_mesh_sheets_surface({{o.surface, o.landmarks, o.units, 0, o.output, o.json, o.refine},
                                     o.target,
@@ -236,18 +246,21 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required()->check(output_file({".vtu"}));
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   CLI::Option* margin =
-      cmd->add_option("--margin", o->margin,
-                      "Core cells have their centre at least this many cell sizes inside the surface "
-                      "(negative: at most that far outside), on every grid; the pillow layer fills the rest "
-                      "(smaller keeps thinner parts in the core). Without it the mesher chooses: -0.4, and "
-                      "for fine cells the better of two cores (docs/meshing.md)")
+      cmd->add_option(
+             "--margin", o->margin,
+             "Core cells of the overlay grid (--method grid) have their centre at least this many "
+             "cell sizes inside the surface (negative: at most that far outside), on every grid; the "
+             "pillow layer fills the rest (smaller keeps thinner parts in the core). Without it the "
+             "mesher chooses: -0.4, and for fine cells the better of two cores (docs/meshing.md)")
           ->check(CLI::Range(-0.8, 2.0))
           ->default_val(o->margin);
-  cmd->add_option("--grid-frame", o->grid_frame,
-                  "Frame of the overlay grid for --method grid: axes, or arch (along the dental arch of a "
-                  "whole mandible in the mandible frame; docs/meshing.md)")
-      ->check(CLI::IsMember({"axes", "arch"}))
-      ->capture_default_str();
+  CLI::Option* grid_frame =
+      cmd->add_option(
+             "--grid-frame", o->grid_frame,
+             "Frame of the overlay grid for --method grid: axes, or arch (along the dental arch of a "
+             "whole mandible in the mandible frame; docs/meshing.md)")
+          ->check(CLI::IsMember({"axes", "arch"}))
+          ->capture_default_str();
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "Move the boundary nodes off the SURFACE along their normals until the "
                 "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "
@@ -255,8 +268,9 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");
   add_refine_options(*cmd, o->refine);
-  cmd->callback([o, margin] {
+  cmd->callback([o, margin, grid_frame] {
     o->margin_given = margin->count() > 0;
+    o->grid_frame_given = grid_frame->count() > 0;
     run_mesh(*o);
   });
 }

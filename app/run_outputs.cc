@@ -436,10 +436,13 @@ std::string summary_table(const RunResult& r) {
   if (r.levels.size() >= 2) {
     const int last = r.levels.back().level;
     out << "relative change, level " << last << " against " << last - 1 << ": bite force ";
-    const auto pct = [&](double (*figure)(const ElasticitySolution&)) {
+    // In percent with 2 decimals, but a small change that would show as 0.00 in scientific notation
+    // (format_table_number); "n/a" when the last level's figure is zero.
+    const auto pct = [&](double (*figure)(const ElasticitySolution&)) -> std::string {
       const json c = relative_change(r, figure);
-      std::snprintf(line, sizeof line, "%+.2f %%", c.is_null() ? 0.0 : 100.0 * c.get<double>());
-      return std::string(line);
+      if (c.is_null()) return "n/a";
+      const double percent = 100.0 * c.get<double>();
+      return (percent > 0 ? "+" : "") + format_table_number(percent, 2, 0) + " %";
     };
     out << pct(bite_force) << ", max displacement " << pct(max_displacement) << ", strain energy "
         << pct(strain_energy) << '\n';

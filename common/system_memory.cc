@@ -4,6 +4,8 @@
 
 #include <cctype>
 #include <fstream>
+#include <sstream>
+#include <vector>
 
 namespace hexbite {
 
@@ -25,13 +27,53 @@ double cgroup_limit(const std::string& path) {
   return bytes > 0 && bytes < kNoLimit ? bytes : 0;
 }
 
+// Whether the comma-separated `controllers` of a /proc/self/cgroup line name the memory controller.
+bool names_memory(const std::string& controllers) {
+  std::istringstream in(controllers);
+  for (std::string controller; std::getline(in, controller, ',');)
+    if (controller == "memory") return true;
+  return false;
+}
+
+// The memory-limit files `file` of the cgroup at `path` ("/a/b", from /proc/self/cgroup) under the hierarchy
+// mounted at `mount`, and of each of its ancestors but the root cgroup ("/a"); none for a path that is not
+// absolute.
+void add_limit_files(const std::string& mount, std::string path, const std::string& file,
+                     std::vector<std::string>& files) {
+  if (path.empty() || path.front() != '/') return;
+  while (!path.empty() && path.back() == '/') path.pop_back();
+  for (; !path.empty(); path.erase(path.rfind('/'))) files.push_back(mount + path + "/" + file);
+}
+
+// The memory-limit files that apply to a process whose /proc/self/cgroup reads `proc_self_cgroup`: the
+// process's own cgroup's and its ancestors' for cgroup v2 ("0::/path") and for the cgroup v1 hierarchy with
+// the memory controller ("N:memory:/path" or "N:cpu,memory:/path"), then the root cgroups', whatever the
+// text.
+std::vector<std::string> limit_files(const std::string& root, const std::string& proc_self_cgroup) {
+  const std::string v2_mount = root + "/sys/fs/cgroup", v1_mount = root + "/sys/fs/cgroup/memory";
+  std::vector<std::string> files;
+  std::istringstream lines(proc_self_cgroup);
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t first = line.find(':'), second = line.find(':', first + 1);
+    if (first == std::string::npos || second == std::string::npos) continue;
+    const std::string hierarchy = line.substr(0, first),
+                      controllers = line.substr(first + 1, second - first - 1),
+                      path = line.substr(second + 1);
+    if (hierarchy == "0" && controllers.empty()) add_limit_files(v2_mount, path, "memory.max", files);
+    if (names_memory(controllers)) add_limit_files(v1_mount, path, "memory.limit_in_bytes", files);
+  }
+  files.push_back(v2_mount + "/memory.max");
+  files.push_back(v1_mount + "/memory.limit_in_bytes");
+  return files;
+}
+
 }  // namespace
 
-MemoryLimit available_memory(double physical_bytes, const std::string& cgroup_v2_max,
-                             const std::string& cgroup_v1_limit) {
+MemoryLimit available_memory(double physical_bytes, const std::string& root,
+                             const std::string& proc_self_cgroup) {
   MemoryLimit limit;
   if (physical_bytes > 0) limit = {physical_bytes, "this machine's physical memory"};
-  for (const std::string& path : {cgroup_v2_max, cgroup_v1_limit}) {
+  for (const std::string& path : limit_files(root, proc_self_cgroup)) {
     const double bytes = cgroup_limit(path);
     if (bytes > 0 && (limit.bytes <= 0 || bytes < limit.bytes))
       limit = {bytes, "the cgroup memory limit in " + path};
@@ -43,7 +85,10 @@ MemoryLimit machine_memory() {
   const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
   const double physical =
       pages > 0 && page_size > 0 ? static_cast<double>(pages) * static_cast<double>(page_size) : 0;
-  return available_memory(physical);
+  std::ifstream in(kProcSelfCgroup);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return available_memory(physical, "", text.str());
 }
 
 }  // namespace hexbite

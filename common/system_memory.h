@@ -1,16 +1,14 @@
 // How much memory this process may use: the machine's physical memory, or less when a control group (a
-// container's or a batch job's memory limit) caps it. `hexbite run` refuses validation levels that would
-// need more (app/run_pipeline.cc).
+// container's, a batch job's or a systemd unit's memory limit) caps it. `hexbite run` refuses validation
+// levels that would need more (app/run_pipeline.cc).
 #pragma once
 
 #include <string>
 
 namespace hexbite {
 
-// The cgroup v2 limit ("max" for none) and the cgroup v1 limit (a huge number, about 2^63, for none), as
-// mounted in a container.
-inline constexpr const char* kCgroupV2MemoryMax = "/sys/fs/cgroup/memory.max";
-inline constexpr const char* kCgroupV1MemoryLimit = "/sys/fs/cgroup/memory/memory.limit_in_bytes";
+// Where the kernel says which cgroups this process is in, one "hierarchy:controllers:/path" line each.
+inline constexpr const char* kProcSelfCgroup = "/proc/self/cgroup";
 
 struct MemoryLimit {
   double bytes = 0;  // 0: not known
@@ -18,13 +16,18 @@ struct MemoryLimit {
   std::string source;
 };
 
-// The smaller of `physical_bytes` (0 or less: not known) and the limits in the cgroup files; a file that is
-// missing, unreadable, "max", not a whole number, or 2^62 bytes or more (cgroup v1's "no limit") sets none.
-// The paths are parameters so that tests can give their own files.
-MemoryLimit available_memory(double physical_bytes, const std::string& cgroup_v2_max = kCgroupV2MemoryMax,
-                             const std::string& cgroup_v1_limit = kCgroupV1MemoryLimit);
+// The smaller of `physical_bytes` (0 or less: not known) and the memory limits of the cgroups of a process
+// whose /proc/self/cgroup reads `proc_self_cgroup`, with the cgroup file systems mounted under `root` ("" for
+// this machine's /): cgroup v2's memory.max (in root/sys/fs/cgroup/<path>) and cgroup v1's
+// memory.limit_in_bytes (in root/sys/fs/cgroup/memory/<path>) of the process's own cgroup, of each of its
+// ancestors, and of the root cgroup (the only one a container that mounts its own cgroup as the root sees).
+// A file that is missing, unreadable, "max", not a whole number, or 2^62 bytes or more (cgroup v1's "no
+// limit") sets none. The root and the text are parameters so that tests can give their own.
+MemoryLimit available_memory(double physical_bytes, const std::string& root,
+                             const std::string& proc_self_cgroup);
 
-// available_memory() of this machine (sysconf's physical pages times the page size) and its cgroup files.
+// available_memory() of this machine (sysconf's physical pages times the page size), its cgroup file
+// systems and its kProcSelfCgroup.
 MemoryLimit machine_memory();
 
 }  // namespace hexbite

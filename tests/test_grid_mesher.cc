@@ -8,6 +8,9 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_boundary.h"
@@ -606,6 +609,32 @@ TEST(MeshCommand, ExplicitMarginMeansOneCore) {
                                         "-0.4", "-o", dir + "/b.vtu", "--json"});
   ASSERT_EQ(given.exit_code, 0) << given.err;
   EXPECT_EQ(nlohmann::json::parse(given.out)["grid_attempts"], 3);
+}
+
+// --method sheets lays no overlay grid; it ignored --margin (and --grid-frame axes) silently, so a user
+// tuning the core saw no effect. The grid's options are refused (exit 2) naming the option, on a SURFACE
+// and on a --quad-surface alike, before any work.
+TEST(MeshCommand, GridOnlyOptionsAreRefusedForTheSheetsMethod) {
+  const std::string dir = test::temp_dir();
+  write_surface(dir + "/sphere.stl", icosphere(10.0, 3));
+  const std::vector<std::vector<std::string>> inputs = {{dir + "/sphere.stl"},
+                                                        {"--quad-surface", dir + "/ball.obj"}};
+  const std::vector<std::pair<std::vector<std::string>, std::string>> options = {
+      {{"--margin", "0.2"}, "--margin 0.2 chooses the core cells of the overlay grid of --method grid"},
+      {{"--margin", "-0.4"}, "--margin -0.4 chooses the core cells"},  // the default, but given
+      {{"--grid-frame", "axes"}, "--grid-frame axes lays the overlay grid of --method grid"}};
+  for (const auto& input : inputs)
+    for (const auto& [option, message] : options) {
+      std::vector<std::string> args = {"mesh", "--method", "sheets", "-o", dir + "/m.vtu"};
+      args.insert(args.end(), input.begin(), input.end());
+      args.insert(args.end(), option.begin(), option.end());
+      const auto r = test::run_hexbite(args);
+      EXPECT_EQ(r.exit_code, 2) << option[0] << " " << r.err;
+      EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+      const std::string advice = "drop " + option[0] + ", or use --method grid";
+      EXPECT_NE(r.err.find(advice), std::string::npos) << r.err;
+      EXPECT_FALSE(std::ifstream(dir + "/m.vtu").good());
+    }
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "app/run_outputs.h"
 #include "common/number_format.h"
 #include "common/system_memory.h"
 #include "mesher/hex_mesh.h"
@@ -640,43 +641,104 @@ TEST(RunScenario, SummaryTablePrintsTinyFiguresInScientificNotation) {
 // The memory guard read the physical memory only: in a container limited by its cgroup to 4 GB of a 64 GB
 // machine it let through a level that needs 40 GB, which then ended in the out-of-memory kill.
 TEST(RunMemoryGuard, AvailableMemoryIsTheSmallerOfPhysicalMemoryAndTheCgroupLimit) {
-  const std::string dir = test::temp_dir();
-  const std::string v2 = dir + "/memory.max", v1 = dir + "/memory.limit_in_bytes", none = dir + "/none";
+  const std::string root = test::temp_dir(), none = test::temp_dir();
+  std::filesystem::create_directories(root + "/sys/fs/cgroup/memory");
+  const std::string v2 = root + "/sys/fs/cgroup/memory.max",
+                    v1 = root + "/sys/fs/cgroup/memory/memory.limit_in_bytes";
   const double physical = 64e9;
   // No cgroup files (or unreadable ones): the physical memory.
-  MemoryLimit m = available_memory(physical, none, none);
+  MemoryLimit m = available_memory(physical, none, "0::/\n");
   EXPECT_EQ(m.bytes, physical);
   EXPECT_EQ(m.source, "this machine's physical memory");
   // cgroup v2: "max" is no limit; a number below the physical memory is the limit.
   test::write_file(v2, "max\n");
-  EXPECT_EQ(available_memory(physical, v2, none).bytes, physical);
+  EXPECT_EQ(available_memory(physical, root, "0::/\n").bytes, physical);
   test::write_file(v2, "4294967296\n");
-  m = available_memory(physical, v2, none);
+  m = available_memory(physical, root, "0::/\n");
   EXPECT_EQ(m.bytes, 4294967296.0);
   EXPECT_EQ(m.source, "the cgroup memory limit in " + v2);
+  // The root cgroup's limit applies whatever /proc/self/cgroup says, even when it could not be read.
+  EXPECT_EQ(available_memory(physical, root, "").source, "the cgroup memory limit in " + v2);
   // A limit above the physical memory changes nothing.
   test::write_file(v2, "128000000000\n");
-  EXPECT_EQ(available_memory(physical, v2, none).source, "this machine's physical memory");
+  EXPECT_EQ(available_memory(physical, root, "0::/\n").source, "this machine's physical memory");
+  std::filesystem::remove(v2);
   // cgroup v1: its "no limit" is the largest page-aligned 64-bit number.
   test::write_file(v1, "9223372036854771712\n");
-  EXPECT_EQ(available_memory(physical, none, v1).source, "this machine's physical memory");
-  EXPECT_EQ(available_memory(0, none, v1).bytes, 0.0);  // nothing known
+  EXPECT_EQ(available_memory(physical, root, "").source, "this machine's physical memory");
+  EXPECT_EQ(available_memory(0, root, "").bytes, 0.0);  // nothing known
   test::write_file(v1, "2147483648\n");
-  m = available_memory(physical, none, v1);
+  m = available_memory(physical, root, "");
   EXPECT_EQ(m.bytes, 2147483648.0);
   EXPECT_EQ(m.source, "the cgroup memory limit in " + v1);
   // Both (a hybrid hierarchy): the smaller; and a limit when the physical memory is not known.
   test::write_file(v2, "4294967296\n");
-  EXPECT_EQ(available_memory(physical, v2, v1).source, "the cgroup memory limit in " + v1);
-  EXPECT_EQ(available_memory(0, v2, none).bytes, 4294967296.0);
+  EXPECT_EQ(available_memory(physical, root, "").source, "the cgroup memory limit in " + v1);
+  std::filesystem::remove(v1);
+  EXPECT_EQ(available_memory(0, root, "").bytes, 4294967296.0);
   // Text that is not a whole number sets no limit.
   for (const char* text : {"", "\n", "-5\n", "4G\n", "0\n", "1e9\n"}) {
     test::write_file(v2, text);
-    EXPECT_EQ(available_memory(physical, v2, none).source, "this machine's physical memory")
+    EXPECT_EQ(available_memory(physical, root, "").source, "this machine's physical memory")
         << "'" << text << "'";
   }
   // This machine: something known.
   EXPECT_GT(machine_memory().bytes, 0.0);
+}
+
+// The memory guard read the root cgroup's files only: a process in a Slurm job or a systemd unit, whose
+// limit is on its own nested cgroup (/sys/fs/cgroup/<path>/memory.max), was let through up to the whole
+// machine's memory.
+TEST(RunMemoryGuard, TheSmallestLimitOfTheProcesssCgroupAndItsAncestorsApplies) {
+  const double physical = 64e9;
+  const std::string root = test::temp_dir(), v2 = root + "/sys/fs/cgroup",
+                    v1 = root + "/sys/fs/cgroup/memory";
+  const std::string job = "/system.slice/slurmstepd.scope/job_42";
+  for (const std::string& dir : {v2 + job, v1 + job}) std::filesystem::create_directories(dir);
+  // cgroup v2, "max" at every level: no limit.
+  for (const std::string& dir : {v2, v2 + "/system.slice", v2 + "/system.slice/slurmstepd.scope", v2 + job})
+    test::write_file(dir + "/memory.max", "max\n");
+  const std::string v2_text = "0::" + job + "\n";
+  EXPECT_EQ(available_memory(physical, root, v2_text).source, "this machine's physical memory");
+  // The job's own limit, and below it an ancestor's smaller one; the smallest wins.
+  test::write_file(v2 + job + "/memory.max", "8589934592\n");
+  MemoryLimit m = available_memory(physical, root, v2_text);
+  EXPECT_EQ(m.bytes, 8589934592.0);
+  EXPECT_EQ(m.source, "the cgroup memory limit in " + v2 + job + "/memory.max");
+  test::write_file(v2 + "/system.slice/memory.max", "4294967296\n");
+  m = available_memory(physical, root, v2_text);
+  EXPECT_EQ(m.bytes, 4294967296.0);
+  EXPECT_EQ(m.source, "the cgroup memory limit in " + v2 + "/system.slice/memory.max");
+  // A larger root limit changes nothing; a process in the root cgroup has the root's limit only.
+  test::write_file(v2 + "/memory.max", "17179869184\n");
+  EXPECT_EQ(available_memory(physical, root, v2_text).bytes, 4294967296.0);
+  EXPECT_EQ(available_memory(physical, root, "0::/\n").bytes, 17179869184.0);
+  // Unreadable files (here directories in their place) are ignored: the next smallest applies.
+  std::filesystem::remove(v2 + "/system.slice/memory.max");
+  std::filesystem::create_directory(v2 + "/system.slice/memory.max");
+  EXPECT_EQ(available_memory(physical, root, v2_text).bytes, 8589934592.0);
+  std::filesystem::remove(v2 + job + "/memory.max");
+  std::filesystem::create_directory(v2 + job + "/memory.max");
+  EXPECT_EQ(available_memory(physical, root, v2_text).bytes, 17179869184.0);
+  // A cgroup the text names but that is not mounted (a container's view of its host's path): the root's.
+  EXPECT_EQ(available_memory(physical, root, "0::/docker/abc\n").bytes, 17179869184.0);
+
+  // cgroup v1: the hierarchy with the memory controller, alone or among others; its huge "no limit" value.
+  std::filesystem::remove_all(v2 + "/memory.max");
+  const std::string v1_huge = "9223372036854771712\n";
+  for (const std::string& dir : {v1, v1 + "/system.slice", v1 + "/system.slice/slurmstepd.scope", v1 + job})
+    test::write_file(dir + "/memory.limit_in_bytes", v1_huge);
+  const std::string v1_text = "12:pids:/\n11:cpu,cpuacct:/other\n4:memory:" + job + "\n1:name=systemd:/\n";
+  EXPECT_EQ(available_memory(physical, root, v1_text).source, "this machine's physical memory");
+  test::write_file(v1 + "/system.slice/slurmstepd.scope/memory.limit_in_bytes", "2147483648\n");
+  m = available_memory(physical, root, v1_text);
+  EXPECT_EQ(m.bytes, 2147483648.0);
+  EXPECT_EQ(m.source,
+            "the cgroup memory limit in " + v1 + "/system.slice/slurmstepd.scope/memory.limit_in_bytes");
+  EXPECT_EQ(available_memory(physical, root, "4:blkio,memory:" + job + "\n").bytes, 2147483648.0);
+  // Another hierarchy's path (here "cpu,cpuacct" naming the job) is not the memory hierarchy's.
+  EXPECT_EQ(available_memory(physical, root, "4:memory:/\n3:cpu,cpuacct:" + job + "\n").source,
+            "this machine's physical memory");
 }
 
 // The summary table's figures (see SummaryTablePrintsTinyFiguresInScientificNotation).
@@ -690,6 +752,33 @@ TEST(RunSummaryTable, FiguresThatFixedPointShowsAsZeroAreInScientificNotation) {
   EXPECT_EQ(format_table_number(0.004, 2, 14), "      4.00e-03");
   EXPECT_EQ(format_table_number(342.5, 2, 14), "        342.50");
   EXPECT_EQ(format_table_number(1.5, 2, 6), "  1.50");
+}
+
+// The relative change of the last level printed "+0.00 %" for a change of 3e-6: a level that changed the
+// bite force a little read as one that changed nothing. Small changes are in scientific notation, a real zero
+// is 0.00, and a figure that is zero on the last level (no relative change) is n/a.
+TEST(RunSummaryTable, RelativeChangeOfTheLastLevelShowsSmallChanges) {
+  RunResult r;
+  r.levels.resize(2);
+  r.levels[1].level = 1;
+  ElasticitySolution &coarse = r.levels[0].solution, &fine = r.levels[1].solution;
+  coarse.bite_force = 300.0;
+  fine.bite_force = 300.0009;  // +3e-6
+  coarse.max_displacement = fine.max_displacement = 0.25;
+  coarse.strain_energy = 99.0;
+  fine.strain_energy = 100.0;
+  std::string table = summary_table(r);
+  EXPECT_NE(table.find("relative change, level 1 against 0: bite force +3.00e-04 %, max displacement 0.00 %, "
+                       "strain energy +1.00 %\n"),
+            std::string::npos)
+      << table;
+  fine.bite_force = 299.9991;
+  fine.max_displacement = 0.0;
+  fine.strain_energy = 80.0;
+  table = summary_table(r);
+  EXPECT_NE(table.find("bite force -3.00e-04 %, max displacement n/a, strain energy -23.75 %\n"),
+            std::string::npos)
+      << table;
 }
 
 // A node on two fixed supports gives its whole reaction to the first one: a bite patch reaching a condyle's
