@@ -48,6 +48,8 @@ struct MeshOptions {
   bool fit_volume = false;
   std::string grid_frame = "axes";  // --method grid: axes or arch (mesher/arch_frame.h)
   bool grid_frame_given = false;    // --grid-frame on the command line (refused with --method sheets)
+  std::string core = "grid";        // --method grid: grid or swept (mesher/swept_core.h); swept implies arch
+  bool core_given = false;          // --core on the command line (refused with --method sheets)
   double margin = GridMeshOptions{}.margin;
   bool margin_given = false;        // --margin on the command line: that margin everywhere, on three grids
   std::string quad_surface;         // --method sheets
@@ -86,10 +88,12 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
   out << "Meshed " << o.surface << " (grid + pillow" << (o.grid_frame == "arch" ? ", along the arch" : "")
-      << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes << " core + " << r.pillow_hexes
-      << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target << "\n";
+      << (r.swept ? ", swept core" : "") << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes
+      << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
+      << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
-      << r.grid[2] << ", " << r.cells_added_for_manifold << " cells added for a manifold core"
+      << r.grid[2] << (r.swept ? " (along the arch x layers across x up)" : "") << ", "
+      << r.cells_added_for_manifold << " cells added for a manifold core"
       << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string())
       << "\n\n";
   out << phase_table(r.optimize) << '\n';
@@ -128,6 +132,7 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
   j["grid_attempts"] = r.attempts;
   j["grid_frame"] = o.grid_frame;
+  j["core"] = r.swept ? "swept" : "grid";
   j["landmarks"] = o.landmarks.empty() ? nlohmann::json() : nlohmann::json(o.landmarks);
   nlohmann::json phases = nlohmann::json::array();
   for (const PhaseQuality& p : r.optimize.phases)
@@ -162,6 +167,7 @@ void run_mesh(const MeshOptions& o) {
   };
   for (const GridOption& g :
        {GridOption{o.grid_frame_given, "--grid-frame", o.grid_frame, "lays the overlay grid"},
+        GridOption{o.core_given, "--core", o.core, "chooses the core"},
         GridOption{o.margin_given, "--margin", fmt("%g", o.margin),
                    "chooses the core cells of the overlay grid"}})
     if (g.given && o.method == "sheets")
@@ -182,6 +188,14 @@ void run_mesh(const MeshOptions& o) {
   if (o.method == "sheets")
     return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
+  if (o.core == "swept" && o.grid_frame == "axes")
+    throw InputError(
+        "--core swept sweeps the core across the dental arch, so it needs --grid-frame arch: "
+        "drop --grid-frame axes, or use --core grid");
+  if (o.core == "swept" && o.margin_given)
+    throw InputError(
+        "--margin chooses the overlay grid's core cells, but --core swept takes columns of the "
+        "bone's side view: drop --margin, or use --core grid");
   const auto [surface, landmarks] = load_mesh_inputs(o.surface, o.units, o.landmarks);
 
   GridMeshOptions options;
@@ -189,6 +203,7 @@ void run_mesh(const MeshOptions& o) {
   options.margin = o.margin;
   options.fit_volume = o.fit_volume;
   options.arch_frame = o.grid_frame == "arch";
+  options.swept_core = o.core == "swept";
   // An explicit margin is a request for that core: no automatic choice of cores for fine cells.
   if (o.margin_given) options.thick_margin_cells = std::numeric_limits<double>::infinity();
   GridMeshReport report;
@@ -210,10 +225,11 @@ void run_mesh(const MeshOptions& o) {
                 << " inverted hexes on purpose (--allow-invalid): " << list << '\n';
       return;
     }
-    throw RunError(
-        std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " + list +
-        "; no mesh written (--allow-invalid writes it anyway" +
-        (options.arch_frame ? "; the axis-aligned grid, --grid-frame axes, may mesh it valid)" : ")"));
+    throw RunError(std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " +
+                   list + "; no mesh written (--allow-invalid writes it anyway" +
+                   (options.swept_core   ? "; the grid core, --core grid, may mesh it valid)"
+                    : options.arch_frame ? "; the axis-aligned grid, --grid-frame axes, may mesh it valid)"
+                                         : ")"));
   }
   if (!o.json) info("wrote " + o.output);
 }
@@ -261,6 +277,14 @@ void add_mesh_command(CLI::App& app) {
              "whole mandible in the mandible frame; docs/meshing.md)")
           ->check(CLI::IsMember({"axes", "arch"}))
           ->capture_default_str();
+  CLI::Option* core =
+      cmd->add_option("--core", o->core,
+                      "Core of --method grid: grid (cells of the overlay grid), or swept (a grid over the "
+                      "bone's side view swept across the dental arch, one hex across the bone per column: "
+                      "better shaped coarse meshes of a whole mandible; implies --grid-frame arch; "
+                      "docs/meshing.md)")
+          ->check(CLI::IsMember({"grid", "swept"}))
+          ->capture_default_str();
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "Move the boundary nodes off the SURFACE along their normals until the "
                 "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "
@@ -268,9 +292,11 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");
   add_refine_options(*cmd, o->refine);
-  cmd->callback([o, margin, grid_frame] {
+  cmd->callback([o, margin, grid_frame, core] {
     o->margin_given = margin->count() > 0;
     o->grid_frame_given = grid_frame->count() > 0;
+    o->core_given = core->count() > 0;
+    if (o->core == "swept" && !o->grid_frame_given) o->grid_frame = "arch";
     run_mesh(*o);
   });
 }

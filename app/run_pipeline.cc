@@ -116,12 +116,16 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   options.target_hexes = s.mesh.target_hexes;
   options.fit_volume = s.mesh.fit_volume;
   options.arch_frame = s.mesh.arch_frame;
+  options.swept_core = s.mesh.swept_core;
   GridMeshReport report;
   HexMesh mesh;
   try {
     mesh = grid_mesh(geometry.surface, options, &report);
   } catch (const NotAnArchError& e) {
-    // A bone that follows no arch is the scenario's grid_frame's fault (other input errors are not).
+    // A bone that follows no arch is the fault of the scenario's grid_frame, or of its swept core (other
+    // input errors are not).
+    if (s.mesh.grid_frame_at.line == 0)
+      throw InputError(s.mesh.core_at.str() + ": mesh.core swept: " + e.what());
     throw InputError(s.mesh.grid_frame_at.str() + ": mesh.grid_frame arch: " + e.what());
   }
   if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
@@ -133,7 +137,10 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   if (report.optimize.inverted > 0)
     throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
-                   "; try another target" + (s.mesh.arch_frame ? " or grid_frame: axes" : "") +
+                   "; try another target" +
+                   (s.mesh.swept_core   ? " or core: grid"
+                    : s.mesh.arch_frame ? " or grid_frame: axes"
+                                        : "") +
                    " (hexbite mesh shows where)");
   return mesh;
 }

@@ -20,6 +20,7 @@
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality_kernel.h"
 #include "mesher/surface_projector.h"
+#include "mesher/swept_core.h"
 #include "mesher/union_find.h"
 #include "mesher/units.h"
 
@@ -1063,6 +1064,7 @@ enum class CoreRule {
   kMargin,  // fine cells too: margin everywhere
   // fine cells: the plain core, less deep cells (regular_margin) where the solid is thick, regularized
   kRegular,
+  kSwept,  // coarse cells along the arch: the core swept across the arch (mesher/swept_core.h)
 };
 
 // Steps 1 and 2 of one grid, shifted by `shift` cells: the cell size and the core (`mesh` holds the core).
@@ -1134,6 +1136,28 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, c
   return out;
 }
 
+// Steps 1 and 2 with the swept core (coarse cells along the arch): `projector` is the straightened surface's.
+// The attempt's selection holds only the cell size, for the messages about the kept grid.
+GridAttempt swept_attempt(const SurfaceProjector& projector, const Vec3& lo, const Vec3& hi,
+                          const GridMeshOptions& options, double shift, const ArchFrame& arch) {
+  const auto t_attempt = std::chrono::steady_clock::now();
+  GridAttempt out;
+  SweptCoreOptions swept;
+  swept.layers = options.swept_layers;
+  SweptCore core = swept_core(projector, lo, hi, options.target_hexes, shift, swept);
+  out.selection.grid.h = core.cell_size;
+  out.selection.grid.n = core.grid;
+  GridMeshReport& r = out.report;
+  r.swept = true;
+  r.cell_size = core.cell_size;
+  r.grid = core.grid;
+  out.mesh = std::move(core.mesh);
+  for (Vec3& v : out.mesh.vertices) v = arch.to_body(v);
+  r.core_hexes = int(out.mesh.hexes.size());
+  r.seconds_core = seconds_since(t_attempt);
+  return out;
+}
+
 // Steps 3 and 4 of one grid: the pillow layer and the optimization.
 void pillow_and_optimize(GridAttempt& attempt, const SurfaceProjector& projector,
                          const OptimizeOptions& optimize) {
@@ -1163,7 +1187,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   std::optional<ArchFrame> arch;
   TriSurface straightened;
   std::unique_ptr<SurfaceProjector> straightened_projector;
-  if (options.arch_frame) {
+  if (options.arch_frame || options.swept_core) {
     arch.emplace(surface);
     straightened = surface;
     for (Vec3& v : straightened.vertices) v = arch->to_arch(v);
@@ -1209,6 +1233,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   // grid only.
   OptimizeOptions per_grid = options.optimize;
   per_grid.mean_jacobian_sweeps = 0;
+  OptimizeOptions per_swept = per_grid;
+  per_swept.boundary_tether = options.swept_tether;
   // The attempts: with coarse cells the plain core on each grid. With fine cells the plain core
   // (fine_margin, the cells whose centre lies inside) on the unshifted and the half-shifted grid, and the
   // thick-margin core (thin plates keep their cells) on the half- and the quarter-shifted grid: the plain
@@ -1221,15 +1247,18 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     double shift;
     CoreRule rule;
   };
-  Job jobs[4 + 2] = {{shifts[0], CoreRule::kRegular}, {shifts[1], CoreRule::kPlain}};
+  // The swept core (options.swept_core) replaces the grid cores: unshifted and shifted by half a cell.
+  const bool swept = options.swept_core;
+  Job jobs[4 + 2] = {{shifts[0], swept ? CoreRule::kSwept : CoreRule::kRegular},
+                     {shifts[1], swept ? CoreRule::kSwept : CoreRule::kPlain}};
   int job_count = 0;  // set with jobs[2] and jobs[3] once attempt 0's core is known
   std::promise<void> jobs_known;
   const std::shared_future<void> jobs_ready = jobs_known.get_future().share();
   auto decide_jobs = [&](bool fine) {
-    job_count = std::min(grids, 2);
-    if (fine)
+    job_count = std::min(grids, 2);  // the swept core: these two only
+    if (!swept && fine)
       for (int a = 1; a < grids; ++a) jobs[job_count++] = {shifts[a], CoreRule::kThick};
-    else if (grids == 3)
+    else if (!swept && grids == 3)
       jobs[job_count++] = {shifts[2], CoreRule::kPlain};
     jobs_known.set_value();
   };
@@ -1237,10 +1266,12 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   std::vector<std::exception_ptr> errors(4 + 2);
   auto run_job = [&](int a) {
     try {
-      if (a > 0)
+      if (a > 0 && jobs[a].rule == CoreRule::kSwept)
+        attempts[a] = swept_attempt(grid_projector, lo, hi, options, jobs[a].shift, *arch);
+      else if (a > 0)
         attempts[a] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
                                 jobs[a].shift, jobs[a].rule, arch_frame);
-      pillow_and_optimize(attempts[a], projector, per_grid);
+      pillow_and_optimize(attempts[a], projector, jobs[a].rule == CoreRule::kSwept ? per_swept : per_grid);
     } catch (...) {
       errors[a] = std::current_exception();
     }
@@ -1261,8 +1292,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     std::vector<std::thread> helpers;
     for (int t = 1; t < std::clamp(options.threads, 1, 4); ++t) helpers.emplace_back(work, true);
     try {
-      attempts[0] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
-                              shifts[0], jobs[0].rule, arch_frame);
+      attempts[0] = swept ? swept_attempt(grid_projector, lo, hi, options, shifts[0], *arch)
+                          : grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness,
+                                      options, shifts[0], jobs[0].rule, arch_frame);
       decide_jobs(attempts[0].fine);
       run_job(0);
     } catch (...) {

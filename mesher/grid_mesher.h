@@ -36,6 +36,8 @@
 //      shifted by half and by a quarter; where the best of them has a measure below 0.3, the two
 //      shifted grids again with margin everywhere (attempts = 6); where another attempt reaches
 //      mean_tie_break but the regular core does not, the regular core on the other two grids (attempts = 6);
+//      With GridMeshOptions::swept_core the attempts are instead the core swept across the arch
+//      (mesher/swept_core.h), unshifted and shifted by half a cell;
 //   6. on the kept mesh only, improve_mean_jacobian raises the mean scaled Jacobian without lowering that
 //      measure (no hex below the smaller of its own value and the mesh's smallest scaled Jacobian; boundary
 //      nodes sliding within worst_element_reach of where the pillow layer put them).
@@ -110,6 +112,15 @@ struct GridMeshOptions {
   // mapped back before the pillow layer) instead of along the axes; for a whole mandible in the mandible
   // frame (throws NotAnArchError, an InputError, for a surface that does not follow an arch).
   bool arch_frame = false;
+  // The core swept across the dental arch (mesher/swept_core.h) instead of the grid cores: a grid over the
+  // bone's side view with swept_layers hexes across the bone in each column, unshifted and shifted by half
+  // a cell (two attempts, the better kept as in step 5). Implies arch_frame. Meant for coarse meshes: with
+  // one layer and the pillow layer every column is three hexes across the bone, at any size.
+  bool swept_core = false;
+  int swept_layers = 1;
+  // The swept core's boundary tether (OptimizeOptions::boundary_tether, 0.5 for the grids): its thin
+  // coronoid and condyle columns otherwise let the boundary slide off their tips (docs/meshing.md).
+  double swept_tether = 0.25;
   // The optimizer's options; the grid mesher skips resting nodes and adds the worst-element pass, twice,
   // with the condition stage (kappa 9.9: the kappa <= 10 with a margin; on the real jaw at 2,500
   // hexes stage 1 stalls at 10.79 on the thin rami), and the mean stage (on the kept grid only) with the
@@ -166,6 +177,7 @@ struct GridMeshReport {
   std::array<int, 3> grid{};  // grid cells per axis
   int core_hexes = 0;
   int pillow_hexes = 0;
+  bool swept = false;  // the kept core is the swept core (grid: cells along s, layers across, cells along z)
   int cells_added_for_manifold = 0;
   int cells_in_dropped_components = 0;
   // Vertices of the core's boundary quad surface, and those of valence other than 4 among them.

@@ -402,7 +402,7 @@ LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, cons
 
 MeshSettings parse_mesh(const Value& v) {
   const Map map(v, {"method", "target_hexes", "validation_levels", "refine_at_bite", "refine_radius_mm",
-                    "refine_levels", "fit_volume", "grid_frame"});
+                    "refine_levels", "fit_volume", "grid_frame", "core"});
   MeshSettings m;
   if (auto x = map.find("method")) {
     m.method = to_choice<MeshMethod>(*x, {{"grid", MeshMethod::kGrid}, {"sheets", MeshMethod::kSheets}});
@@ -457,6 +457,19 @@ MeshSettings parse_mesh(const Value& v) {
       fail(x->at,
            "mesh.grid_frame lays the overlay grid of method grid, but mesh.method is sheets; remove "
            "grid_frame or write method: grid");
+  }
+  if (auto x = map.find("core")) {
+    m.swept_core = to_choice<bool>(*x, {{"grid", false}, {"swept", true}});
+    m.core_at = x->at;
+    if (m.method != MeshMethod::kGrid)
+      fail(x->at,
+           "mesh.core chooses the core of method grid, but mesh.method is sheets; remove core or write "
+           "method: grid");
+    if (m.swept_core && m.grid_frame_at.line > 0 && !m.arch_frame)
+      fail(x->at,
+           "mesh.core swept sweeps the core across the dental arch, but mesh.grid_frame is axes; write "
+           "grid_frame: arch, leave it out, or write core: grid");
+    if (m.swept_core) m.arch_frame = true;
   }
   return m;
 }

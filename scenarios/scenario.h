@@ -80,6 +80,10 @@ struct MeshSettings {
   // method grid only: lay the overlay grid along the dental arch (GridMeshOptions::arch_frame).
   bool arch_frame = false;
   SourceLocation grid_frame_at;  // where grid_frame was written
+  // method grid only: the core swept across the dental arch (GridMeshOptions::swept_core); implies the
+  // arch frame.
+  bool swept_core = false;
+  SourceLocation core_at;  // where core was written
 };
 
 struct MaterialSpec {

@@ -9,4 +9,7 @@ namespace hexbite::test {
 // With n much larger than m its triangles are needles.
 TriSurface torus(int n, int m);
 
+// The closed box [0, a] x [0, b] x [0, c], outward, each face split into 2 x 2 quads of two triangles.
+TriSurface box(double a, double b, double c);
+
 }  // namespace hexbite::test

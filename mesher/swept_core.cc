@@ -1,0 +1,209 @@
+#include "mesher/swept_core.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "common/error.h"
+#include "common/progress.h"
+
+namespace hexbite {
+
+namespace {
+
+// The bone along the line across the arch at (s, z): between the line's outermost crossings of the surface.
+struct Interval {
+  double a = 0, b = 0;
+  int crossings = 0;  // 0: the line misses the bone
+  double thickness() const { return crossings >= 2 ? b - a : 0.0; }
+};
+
+Interval across(const SurfaceProjector& surface, double s, double z, double t_lo, double t_hi) {
+  std::vector<double> t;
+  // A line that grazes an edge or a vertex gives no reliable crossings: it is moved by a hair and tried
+  // again.
+  for (int nudge = 0; nudge < 3; ++nudge) {
+    const double d = nudge * 1e-6 * (t_hi - t_lo);
+    if (surface.segment_crossings({s + d, t_lo, z + 0.7 * d}, {s + d, t_hi, z + 0.7 * d}, &t)) break;
+    t.clear();
+  }
+  if (t.size() < 2) return {};
+  return {t_lo + t.front() * (t_hi - t_lo), t_lo + t.back() * (t_hi - t_lo), int(t.size())};
+}
+
+// One trial size: the (s, z) grid and its selected columns.
+struct Layout {
+  double h = 0, s0 = 0, z0 = 0;
+  int ns = 0, nz = 0;
+  std::vector<Interval> centre;  // per cell, at its centre
+  std::vector<char> selected;
+  long columns = 0, outline_edges = 0;
+  long cell(int i, int j) const { return long(j) * ns + i; }
+};
+
+// Keeps the largest edge-connected set of selected cells and drops one cell of every pair that meets only
+// at a corner, until neither changes anything.
+void make_manifold(Layout& l) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int j = 0; j + 1 < l.nz; ++j)
+      for (int i = 0; i + 1 < l.ns; ++i) {
+        const long c00 = l.cell(i, j), c10 = c00 + 1, c01 = c00 + l.ns, c11 = c01 + 1;
+        if (l.selected[c00] && l.selected[c11] && !l.selected[c10] && !l.selected[c01])
+          l.selected[c11] = 0, changed = true;
+        if (l.selected[c10] && l.selected[c01] && !l.selected[c00] && !l.selected[c11])
+          l.selected[c01] = 0, changed = true;
+      }
+    std::vector<int> component(l.selected.size(), -1);
+    int largest = -1, count = 0;
+    long largest_size = 0;
+    for (long c = 0; c < long(l.selected.size()); ++c) {
+      if (!l.selected[c] || component[c] >= 0) continue;
+      std::vector<long> stack{c};
+      component[c] = count;
+      long size = 0;
+      while (!stack.empty()) {
+        const long x = stack.back();
+        stack.pop_back();
+        ++size;
+        const int i = int(x % l.ns), j = int(x / l.ns);
+        const int next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+        for (const auto& n : next) {
+          if (n[0] < 0 || n[0] >= l.ns || n[1] < 0 || n[1] >= l.nz) continue;
+          const long y = l.cell(n[0], n[1]);
+          if (l.selected[y] && component[y] < 0) component[y] = count, stack.push_back(y);
+        }
+      }
+      if (size > largest_size) largest_size = size, largest = count;
+      ++count;
+    }
+    for (long c = 0; c < long(l.selected.size()); ++c)
+      if (l.selected[c] && component[c] != largest) l.selected[c] = 0, changed = true;
+  }
+}
+
+Layout lay_out(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, double h, double shift,
+               const SweptCoreOptions& options) {
+  Layout l;
+  l.h = h;
+  l.s0 = lo[0] - h * (1.0 - shift);
+  l.z0 = lo[2] - h * (1.0 - shift);
+  l.ns = int(std::ceil((hi[0] - l.s0) / h)) + 1;
+  l.nz = int(std::ceil((hi[2] - l.z0) / h)) + 1;
+  const double t_lo = lo[1] - h, t_hi = hi[1] + h;
+  l.centre.resize(std::size_t(l.ns) * l.nz);
+  l.selected.assign(l.centre.size(), 0);
+  for (int j = 0; j < l.nz; ++j)
+    for (int i = 0; i < l.ns; ++i) {
+      const long c = l.cell(i, j);
+      l.centre[c] = across(surface, l.s0 + (i + 0.5) * h, l.z0 + (j + 0.5) * h, t_lo, t_hi);
+      l.selected[c] = l.centre[c].thickness() >= options.min_thickness_cells * h;
+    }
+  make_manifold(l);
+  for (int j = 0; j < l.nz; ++j)
+    for (int i = 0; i < l.ns; ++i) {
+      if (!l.selected[l.cell(i, j)]) continue;
+      ++l.columns;
+      const int next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+      for (const auto& n : next)
+        if (n[0] < 0 || n[0] >= l.ns || n[1] < 0 || n[1] >= l.nz || !l.selected[l.cell(n[0], n[1])])
+          ++l.outline_edges;
+    }
+  return l;
+}
+
+// The hexes of the kept layout, `layers` per column.
+SweptCore build(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, const Layout& l,
+                const SweptCoreOptions& options) {
+  SweptCore out;
+  out.cell_size = l.h;
+  out.grid = {l.ns, options.layers, l.nz};
+  out.columns = l.columns;
+  out.outline_edges = l.outline_edges;
+  const double t_lo = lo[1] - l.h, t_hi = hi[1] + l.h;
+  const int nv = l.ns + 1;
+  auto vertex = [nv](int i, int j) { return long(j) * nv + i; };
+  std::vector<int> id(std::size_t(nv) * (l.nz + 1), -1);
+  for (int j = 0; j < l.nz; ++j)
+    for (int i = 0; i < l.ns; ++i)
+      if (l.selected[l.cell(i, j)])
+        for (int b = 0; b < 4; ++b) id[vertex(i + (b & 1), j + (b >> 1))] = 0;
+  const int layers = options.layers;
+  for (long v = 0; v < long(id.size()); ++v) {
+    if (id[v] < 0) continue;
+    const int i = int(v % nv), j = int(v / nv);
+    const double s = l.s0 + i * l.h, z = l.z0 + j * l.h;
+    Interval bone = across(surface, s, z, t_lo, t_hi);
+    if (bone.crossings > 2) ++out.split_vertices;
+    if (bone.thickness() < 0.5 * options.min_thickness_cells * l.h) {
+      // Outside the side view (or nearly): the mean interval of the vertex's columns.
+      Interval mean{0, 0, 2};
+      int n = 0;
+      for (int b = 0; b < 4; ++b) {
+        const int ci = i - 1 + (b & 1), cj = j - 1 + (b >> 1);
+        if (ci < 0 || cj < 0 || ci >= l.ns || cj >= l.nz || !l.selected[l.cell(ci, cj)]) continue;
+        mean.a += l.centre[l.cell(ci, cj)].a;
+        mean.b += l.centre[l.cell(ci, cj)].b;
+        ++n;
+      }
+      bone = {mean.a / n, mean.b / n, 2};
+    }
+    // Both faces pulled in by a third of a cell, or of the thickness where the bone is thinner.
+    const double inset = std::min(l.h, bone.thickness()) / 3.0;
+    const double a = bone.a + inset, b = bone.b - inset;
+    id[v] = int(out.mesh.vertices.size());
+    for (int k = 0; k <= layers; ++k) out.mesh.vertices.push_back({s, a + (b - a) * k / layers, z});
+  }
+  // Axes (s, t, z) in the order of core_mesh's (x, y, z), which is right-handed in arch coordinates.
+  for (int j = 0; j < l.nz; ++j)
+    for (int i = 0; i < l.ns; ++i) {
+      if (!l.selected[l.cell(i, j)]) continue;
+      const int p = id[vertex(i, j)], q = id[vertex(i + 1, j)], r = id[vertex(i + 1, j + 1)],
+                w = id[vertex(i, j + 1)];
+      for (int k = 0; k < layers; ++k)
+        out.mesh.hexes.push_back({p + k, q + k, q + k + 1, p + k + 1, w + k, r + k, r + k + 1, w + k + 1});
+    }
+  return out;
+}
+
+}  // namespace
+
+SweptCore swept_core(const SurfaceProjector& straightened, const Vec3& lo, const Vec3& hi, long target_hexes,
+                     double shift, const SweptCoreOptions& options) {
+  // Start where a third of the side view's box holds the columns: the secant steps correct it.
+  const double target = double(target_hexes);
+  const double per_column = options.layers + 2.5;
+  double h = std::sqrt((hi[0] - lo[0]) * (hi[2] - lo[2]) / 3.0 / (target / per_column));
+  Progress progress("swept core");
+  Layout best;
+  double best_error = std::numeric_limits<double>::infinity();
+  double prev_h = 0, prev_total = 0;
+  for (int step = 0; step < 8; ++step) {
+    Layout l = lay_out(straightened, lo, hi, h, shift, options);
+    const double total = double(l.columns * (options.layers + 2) + l.outline_edges * options.layers);
+    const double error = std::fabs(total - target) / target;
+    if (l.columns > 0 && error < best_error) best_error = error, best = std::move(l);
+    progress.update(double(step + 1) / 8,
+                    "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
+    if (best_error < 0.02) break;
+    // The count falls like h^-2 (columns) to h^-1 (outline); start from the slope -2.
+    double slope = -2.0;
+    if (prev_total > 0 && total > 0 && prev_h != h) {
+      const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
+      if (fitted < -0.5 && fitted > -4.0) slope = fitted;
+    }
+    prev_h = h;
+    prev_total = total;
+    h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
+  }
+  if (best.columns == 0)
+    throw InputError(
+        "swept core: no column of the bone's side view holds it a quarter of a cell thick at any "
+        "trial cell size for " +
+        std::to_string(target_hexes) + " hexes; ask for more hexes, or use the grid core (--core grid)");
+  return build(straightened, lo, hi, best, options);
+}
+
+}  // namespace hexbite

@@ -1,0 +1,118 @@
+// The core swept across the dental arch (mesher/swept_core.h) on boxes in arch coordinates, and the grid
+// mesher with it (GridMeshOptions::swept_core) on the built-in mandible and the real jaw at the paper's
+// coarse size, where the overlay grid's means stay near 0.8.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.h"
+#include "mesher/grid_mesher.h"
+#include "mesher/hex_quality.h"
+#include "mesher/mandible_generator.h"
+#include "mesher/surface_check.h"
+#include "mesher/surface_projector.h"
+#include "mesher/swept_core.h"
+#include "tests/test_shapes.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+// A straight 120 x 10 x 30 mm bar (s, t, z) moved to t in [-5, 5]: one column across per cell, both faces
+// a third of a cell inside, every hex a box, and the count (hexes + the pillow layer's quads) near the
+// target.
+TEST(SweptCore, ColumnsSpanTheBarAcrossTheArch) {
+  TriSurface bar = test::box(120.0, 10.0, 30.0);
+  for (Vec3& v : bar.vertices) v[1] -= 5.0;
+  const SurfaceProjector surface(bar);
+  const SweptCore core = swept_core(surface, {0, -5, 0}, {120, 5, 30}, 800, 0.0);
+  ASSERT_GT(core.columns, 0);
+  EXPECT_EQ(long(core.mesh.hexes.size()), core.columns);
+  EXPECT_EQ(core.grid[1], 1);
+  EXPECT_EQ(core.split_vertices, 0);
+  const double inset = std::min(core.cell_size, 10.0) / 3.0;
+  for (const Vec3& v : core.mesh.vertices) {
+    EXPECT_NEAR(std::fabs(v[1]), 5.0 - inset, 1e-9);
+    EXPECT_GE(v[0], -core.cell_size);
+    EXPECT_LE(v[0], 120.0 + core.cell_size);
+  }
+  const QualitySummary q = summarize_quality(core.mesh);
+  EXPECT_EQ(q.inverted, 0);
+  EXPECT_NEAR(q.scaled_jacobian.min, 1.0, 1e-9);
+  const double total = double(core.columns * 3 + core.outline_edges);
+  EXPECT_NEAR(total, 800.0, 0.1 * 800.0);
+}
+
+// Two bars side by side across the arch, 4 mm apart: each line across crosses the surface four times; the
+// core spans both (the outermost crossings) and reports the split lines, which the pillow layer pulls back.
+TEST(SweptCore, LinesCrossingTheBoneMoreThanTwiceTakeTheOutermostCrossings) {
+  TriSurface two = test::box(60.0, 6.0, 20.0);
+  const TriSurface second = test::box(60.0, 6.0, 20.0);
+  const int offset = int(two.vertices.size());
+  for (Vec3 v : second.vertices) two.vertices.push_back({v[0], v[1] + 10.0, v[2]});
+  for (const auto& t : second.triangles)
+    two.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  const SurfaceProjector surface(two);
+  const SweptCore core = swept_core(surface, {0, 0, 0}, {60, 16, 20}, 400, 0.0, {2, 0.25});
+  ASSERT_GT(core.columns, 0);
+  EXPECT_GT(core.split_vertices, 0);
+  EXPECT_EQ(long(core.mesh.hexes.size()), 2 * core.columns);
+  double t_min = 1e9, t_max = -1e9;
+  for (const Vec3& v : core.mesh.vertices) t_min = std::min(t_min, v[1]), t_max = std::max(t_max, v[1]);
+  EXPECT_LT(t_min, 3.0);
+  EXPECT_GT(t_max, 13.0);
+  EXPECT_EQ(summarize_quality(core.mesh).inverted, 0);
+}
+
+// A box that holds none of the bone (a caller's wrong bounds) gives no column at any size: refused.
+TEST(SweptCore, NoColumnAtAnySizeIsRefused) {
+  const SurfaceProjector surface(test::box(100.0, 10.0, 40.0));
+  const std::string message = test::message_of<InputError>([&] {
+    swept_core(surface, {300, 0, 0}, {400, 10, 40}, 500, 0.0);
+  });
+  EXPECT_NE(message.find("no column of the bone's side view"), std::string::npos) << message;
+}
+
+struct Coarse {
+  QualitySummary quality;
+  GridMeshReport report;
+  long hexes = 0;
+};
+
+Coarse mesh_swept(const TriSurface& surface) {
+  GridMeshOptions options;
+  options.target_hexes = 2500;
+  options.swept_core = true;
+  Coarse c;
+  const HexMesh mesh = grid_mesh(surface, options, &c.report);
+  c.quality = summarize_quality(mesh);
+  c.hexes = long(mesh.hexes.size());
+  return c;
+}
+
+// Issue 3's coarse element targets (0 inverted, scaled Jacobian min >= 0.3 and mean >= 0.85, kappa max <= 10
+// at about 2,500 hexes), which the overlay grid misses on both bones (means 0.79 / 0.76 along the axes,
+// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-22: built-in mandible 2,512 hexes, 0.563 /
+// 0.907, kappa 5.99; real jaw 2,497 hexes, 0.448 / 0.895, kappa 7.58. The fidelity is what the swept core
+// gives up: the built-in mandible's condyle poles lie 4-5 mm from the mesh (Hausdorff 1.71 mean edges
+// against 0.64 along the axes), and neither bone's volume is within 3 % (-4.45 / -4.53 %).
+TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
+  const Coarse m = mesh_swept(generate_mandible({}).surface);
+  const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
+  const Coarse j = mesh_swept(jaw);
+  for (const Coarse* c : {&m, &j}) {
+    EXPECT_TRUE(c->report.swept);
+    EXPECT_EQ(c->report.attempts, 2);
+    EXPECT_NEAR(double(c->hexes), 2500.0, 250.0);
+    EXPECT_EQ(c->quality.inverted, 0);
+    EXPECT_GE(c->quality.scaled_jacobian.min, 0.4);
+    EXPECT_GE(c->quality.scaled_jacobian.mean, 0.88);
+    EXPECT_LE(c->quality.condition.max, 8.0);
+    EXPECT_LT(std::fabs(c->report.fidelity.volume_difference), 0.05);
+    EXPECT_LT(c->report.fidelity.hausdorff, 2.0 * c->report.fidelity.mean_edge_length);
+  }
+}
+
+}  // namespace
+}  // namespace hexbite
