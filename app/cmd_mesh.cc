@@ -17,6 +17,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "app/commands.h"
@@ -46,16 +47,16 @@ struct MeshOptions {
   bool json = false;
   bool allow_invalid = false;
   bool fit_volume = false;
-  std::string grid_frame = "axes";  // --method grid: axes or arch (mesher/arch_frame.h)
-  bool grid_frame_given = false;    // --grid-frame on the command line (refused with --method sheets)
-  std::string core = "grid";        // --method grid: grid or swept (mesher/swept_core.h); swept implies arch
-  bool core_given = false;          // --core on the command line (refused with --method sheets)
-  double margin = GridMeshOptions{}.margin;
-  bool margin_given = false;        // --margin on the command line: that margin everywhere, on three grids
-  std::string quad_surface;         // --method sheets
-  std::string order = "geometric";  // --method sheets
-  std::string landmarks;            // --method sheets on a SURFACE; names unresolved parts for grid
-  RefineCommandOptions refine;      // --method sheets on a SURFACE
+  std::string grid_frame = "axes";           // --method grid: axes or arch (mesher/arch_frame.h)
+  std::string core = "grid";                 // --method grid: grid or swept (mesher/swept_core.h)
+  double margin = GridMeshOptions{}.margin;  // given: that margin everywhere, on three grids
+  std::string quad_surface;                  // --method sheets
+  std::string order = "geometric";           // --method sheets
+  std::string landmarks;                     // --method sheets on a SURFACE; names unresolved parts for grid
+  RefineCommandOptions refine;               // --method sheets on a SURFACE
+  // The options given on the command line (count() > 0, so never a default), by name: "--margin", "surface".
+  std::set<std::string> given;
+  bool was_given(const std::string& name) const { return given.count(name) > 0; }
 };
 
 std::string fmt(const char* format, double v) {
@@ -155,36 +156,77 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   return j;
 }
 
-void run_mesh(const MeshOptions& o) {
-  if (o.fit_volume && !o.quad_surface.empty())
-    throw InputError(
-        "--fit-volume moves boundary nodes off the SURFACE, but a mesh of --quad-surface keeps that quad "
-        "surface exactly as its boundary: drop --fit-volume, or mesh the triangulated SURFACE");
-  // --method sheets lays no overlay grid: the grid's options are refused rather than ignored.
-  struct GridOption {
-    bool given;
-    std::string name, value, what;
+// The three paths of `hexbite mesh`: the overlay grid on a SURFACE, the sheet mesher on a mandible SURFACE
+// (through the quad template placed on it) and the sheet mesher on a --quad-surface.
+enum class MeshPath { grid, sheets_on_surface, sheets_on_quads };
+
+// An option given on the command line that the chosen path would ignore is refused (exit 2) rather than
+// ignored, so that a user tuning it learns that it does nothing there: "<name> <value> <what>, but <why>:
+// drop <name>, or <instead>". Nothing is read or meshed before.
+void refuse_ignored_options(const MeshOptions& o, MeshPath path) {
+  struct IgnoredOption {
+    bool ignored;  // given, and the chosen path ignores it
+    std::string name, value, what, why, instead;
   };
-  for (const GridOption& g :
-       {GridOption{o.grid_frame_given, "--grid-frame", o.grid_frame, "lays the overlay grid"},
-        GridOption{o.core_given, "--core", o.core, "chooses the core"},
-        GridOption{o.margin_given, "--margin", fmt("%g", o.margin),
-                   "chooses the core cells of the overlay grid"}})
-    if (g.given && o.method == "sheets")
-      throw InputError(g.name + " " + g.value + " " + g.what +
-                       " of --method grid, but --method sheets has no grid: drop " + g.name +
-                       ", or use --method grid");
+  const bool grid = path == MeshPath::grid, quads = path == MeshPath::sheets_on_quads;
+  const IgnoredOption options[] = {
+      {grid && o.was_given("--quad-surface"), "--quad-surface", o.quad_surface,
+       "is the boundary that --method sheets keeps exactly",
+       "--method grid meshes a triangulated SURFACE with an overlay grid", "use --method sheets"},
+      {quads && o.was_given("surface"), "the SURFACE", o.surface,
+       "is meshed by --method grid, or by --method sheets through the mandible quad template placed on it",
+       "--method sheets with --quad-surface meshes that quad surface alone",
+       "drop --quad-surface to mesh the SURFACE"},
+      {!grid && o.was_given("--grid-frame"), "--grid-frame", o.grid_frame,
+       "lays the overlay grid of --method grid", "--method sheets has no grid", "use --method grid"},
+      {!grid && o.was_given("--margin"), "--margin", fmt("%g", o.margin),
+       "chooses the core cells of the overlay grid of --method grid", "--method sheets has no grid",
+       "use --method grid"},
+      {!grid && o.was_given("--core"), "--core", o.core, "chooses the core of --method grid",
+       "--method sheets has no grid", "use --method grid"},
+      {grid && o.core == "swept" && o.was_given("--margin"), "--margin", fmt("%g", o.margin),
+       "chooses the core cells of the overlay grid", "--core swept takes columns of the bone's side view",
+       "use --core grid"},
+      {grid && o.was_given("--order"), "--order", o.order,
+       "orders the cycle elimination of the sheet mesher, --method sheets",
+       "--method grid eliminates no sheets (it fills an overlay grid)", "use --method sheets"},
+      {quads && o.was_given("--target-hexes"), "--target-hexes", std::to_string(o.target),
+       "sets the size of the mesh of a SURFACE",
+       "the hex count of a mesh of --quad-surface follows from its quads (the quad surface is kept exactly "
+       "as the boundary)",
+       "give a finer or coarser quad surface (hexbite quad from-mandible --target-quads)"},
+      {quads && o.was_given("--landmarks"), "--landmarks", o.landmarks,
+       "places the mandible quad template on a SURFACE (--method sheets) and names the parts too thin for "
+       "the cells (--method grid)",
+       "a mesh of --quad-surface places no template and has no SURFACE to compare with",
+       "give them to hexbite quad from-mandible, which places the template"},
+      {quads && o.was_given("--units"), "--units", o.units,
+       "is the length unit of the SURFACE file (converted to mm)",
+       "a --quad-surface is meshed in its own coordinates, without conversion",
+       "give it to hexbite quad from-mandible, which writes the quad surface in mm"},
+      {quads && o.was_given("--fit-volume"), "--fit-volume", "", "moves boundary nodes off the SURFACE",
+       "a mesh of --quad-surface keeps that quad surface exactly as its boundary",
+       "mesh the triangulated SURFACE"},
+      {path != MeshPath::sheets_on_surface && o.was_given("--refine-at"), "--refine-at", o.refine.at,
+       "refines the quad surface that --method sheets places on a mandible SURFACE",
+       grid ? "--method grid places no quad surface" : "a --quad-surface is meshed as it is",
+       "run --method sheets on the SURFACE"}};
+  for (const IgnoredOption& g : options)
+    if (g.ignored)
+      throw InputError(g.name + (g.value.empty() ? "" : " " + g.value) + " " + g.what + ", but " + g.why +
+                       ": drop " + g.name + ", or " + g.instead);
+}
+
+void run_mesh(const MeshOptions& o) {
+  refuse_ignored_options(o, o.method == "grid"       ? MeshPath::grid
+                            : o.quad_surface.empty() ? MeshPath::sheets_on_surface
+                                                     : MeshPath::sheets_on_quads);
   if (o.method == "sheets" && o.quad_surface.empty() && !o.surface.empty())
     return run_mesh_sheets_surface({{o.surface, o.landmarks, o.units, 0, o.output, o.json, o.refine},
                                     o.target,
                                     o.order,
                                     o.allow_invalid,
                                     o.fit_volume});
-  if (!o.refine.at.empty())
-    throw InputError(
-        "--refine-at refines the quad surface that --method sheets places on a mandible SURFACE; "
-        "it does nothing for --method grid or --quad-surface: drop it, or run --method sheets on "
-        "the SURFACE");
   if (o.method == "sheets")
     return run_mesh_sheets({o.quad_surface, o.output, o.order, o.json, o.allow_invalid});
   if (o.surface.empty()) throw InputError("--method grid needs the SURFACE to mesh");
@@ -192,10 +234,6 @@ void run_mesh(const MeshOptions& o) {
     throw InputError(
         "--core swept sweeps the core across the dental arch, so it needs --grid-frame arch: "
         "drop --grid-frame axes, or use --core grid");
-  if (o.core == "swept" && o.margin_given)
-    throw InputError(
-        "--margin chooses the overlay grid's core cells, but --core swept takes columns of the "
-        "bone's side view: drop --margin, or use --core grid");
   const auto [surface, landmarks] = load_mesh_inputs(o.surface, o.units, o.landmarks);
 
   GridMeshOptions options;
@@ -205,7 +243,7 @@ void run_mesh(const MeshOptions& o) {
   options.arch_frame = o.grid_frame == "arch";
   options.swept_core = o.core == "swept";
   // An explicit margin is a request for that core: no automatic choice of cores for fine cells.
-  if (o.margin_given) options.thick_margin_cells = std::numeric_limits<double>::infinity();
+  if (o.was_given("--margin")) options.thick_margin_cells = std::numeric_limits<double>::infinity();
   GridMeshReport report;
   const HexMesh mesh = grid_mesh(surface, options, &report);
   if (landmarks) name_unresolved_parts(*landmarks, report.fidelity.unresolved);
@@ -261,30 +299,25 @@ void add_mesh_command(CLI::App& app) {
       ->transform(count_in_range(kMinTargetHexes, kMaxTargetHexes));
   cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required()->check(output_file({".vtu"}));
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
-  CLI::Option* margin =
-      cmd->add_option(
-             "--margin", o->margin,
-             "Core cells of the overlay grid (--method grid) have their centre at least this many "
-             "cell sizes inside the surface (negative: at most that far outside), on every grid; the "
-             "pillow layer fills the rest (smaller keeps thinner parts in the core). Without it the "
-             "mesher chooses: -0.4, and for fine cells the better of two cores (docs/meshing.md)")
-          ->check(CLI::Range(-0.8, 2.0))
-          ->default_val(o->margin);
-  CLI::Option* grid_frame =
-      cmd->add_option(
-             "--grid-frame", o->grid_frame,
-             "Frame of the overlay grid for --method grid: axes, or arch (along the dental arch of a "
-             "whole mandible in the mandible frame; docs/meshing.md)")
-          ->check(CLI::IsMember({"axes", "arch"}))
-          ->capture_default_str();
-  CLI::Option* core =
-      cmd->add_option("--core", o->core,
-                      "Core of --method grid: grid (cells of the overlay grid), or swept (a grid over the "
-                      "bone's side view swept across the dental arch, one hex across the bone per column: "
-                      "better shaped coarse meshes of a whole mandible; implies --grid-frame arch; "
-                      "docs/meshing.md)")
-          ->check(CLI::IsMember({"grid", "swept"}))
-          ->capture_default_str();
+  cmd->add_option("--margin", o->margin,
+                  "Core cells of the overlay grid (--method grid) have their centre at least this many "
+                  "cell sizes inside the surface (negative: at most that far outside), on every grid; the "
+                  "pillow layer fills the rest (smaller keeps thinner parts in the core). Without it the "
+                  "mesher chooses: -0.4, and for fine cells the better of two cores (docs/meshing.md)")
+      ->check(CLI::Range(-0.8, 2.0))
+      ->default_val(o->margin);
+  cmd->add_option("--grid-frame", o->grid_frame,
+                  "Frame of the overlay grid for --method grid: axes, or arch (along the dental arch of a "
+                  "whole mandible in the mandible frame; docs/meshing.md)")
+      ->check(CLI::IsMember({"axes", "arch"}))
+      ->capture_default_str();
+  cmd->add_option("--core", o->core,
+                  "Core of --method grid: grid (cells of the overlay grid), or swept (a grid over the "
+                  "bone's side view swept across the dental arch, one hex across the bone per column: "
+                  "better shaped coarse meshes of a whole mandible; implies --grid-frame arch; "
+                  "docs/meshing.md)")
+      ->check(CLI::IsMember({"grid", "swept"}))
+      ->capture_default_str();
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "Move the boundary nodes off the SURFACE along their normals until the "
                 "boundary quads straddle it (the mesh's volume matches the surface's; nodes end up to a "
@@ -292,11 +325,11 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the table");
   cmd->add_flag("--allow-invalid", o->allow_invalid, "Write the mesh even when hexes stay inverted");
   add_refine_options(*cmd, o->refine);
-  cmd->callback([o, margin, grid_frame, core] {
-    o->margin_given = margin->count() > 0;
-    o->grid_frame_given = grid_frame->count() > 0;
-    o->core_given = core->count() > 0;
-    if (o->core == "swept" && !o->grid_frame_given) o->grid_frame = "arch";
+  cmd->callback([o, cmd] {
+    for (const CLI::Option* option : cmd->get_options())
+      if (option->count() > 0) o->given.insert(option->get_name());
+    // The swept core lies along the arch: --core swept alone implies --grid-frame arch.
+    if (o->core == "swept" && !o->was_given("--grid-frame")) o->grid_frame = "arch";
     run_mesh(*o);
   });
 }

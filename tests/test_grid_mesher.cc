@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -599,6 +600,98 @@ TEST(MeshCommand, GridOnlyOptionsAreRefusedForTheSheetsMethod) {
       EXPECT_NE(r.err.find(advice), std::string::npos) << r.err;
       EXPECT_FALSE(std::ifstream(dir + "/m.vtu").good());
     }
+}
+
+// Every other option of `hexbite mesh` that the chosen path ignored silently is refused too (exit 2), by the
+// same table, naming the option, why the path ignores it and what to do, before anything is read: --order
+// and --quad-surface with --method grid; a SURFACE, --target-hexes, --landmarks and --units with
+// --quad-surface (the hex count follows from the quads, kept exactly); --refine-at on a --quad-surface.
+// Given is what counts: the same path with the defaults, and each option where it applies, still mesh.
+TEST(MeshCommand, OptionsThatThePathIgnoresAreRefused) {
+  const std::string dir = test::temp_dir();
+  write_surface(dir + "/sphere.stl", icosphere(10.0, 2));
+  test::write_file(dir + "/cube.obj",
+                   "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                   "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+  const std::string landmarks = test::shared_data("jaw/landmarks.yaml");
+  const std::vector<std::string> grid = {"--method", "grid", dir + "/sphere.stl", "--target-hexes", "200"};
+  const std::vector<std::string> quads = {"--method", "sheets", "--quad-surface", dir + "/cube.obj"};
+  struct Case {
+    std::vector<std::string> path, option;
+    std::string message, advice;
+  };
+  const std::vector<Case> cases = {
+      {grid,
+       {"--order", "look-ahead"},
+       "--order look-ahead orders the cycle elimination of the sheet mesher, --method sheets, but --method "
+       "grid eliminates no sheets",
+       "drop --order, or use --method sheets"},
+      {grid, {"--order", "geometric"}, "--order geometric orders the cycle elimination", ""},  // the default
+      {grid,
+       {"--quad-surface", dir + "/cube.obj"},
+       "--quad-surface " + dir +
+           "/cube.obj is the boundary that --method sheets keeps exactly, but --method grid",
+       "drop --quad-surface, or use --method sheets"},
+      {{"--quad-surface", dir + "/cube.obj"}, {}, "but --method grid meshes a triangulated SURFACE", ""},
+      {quads,
+       {dir + "/sphere.stl"},
+       "the SURFACE " + dir + "/sphere.stl is meshed by --method grid, or by --method sheets",
+       "drop the SURFACE, or drop --quad-surface to mesh the SURFACE"},
+      {quads,
+       {"--target-hexes", "500"},
+       "--target-hexes 500 sets the size of the mesh of a SURFACE, but the hex count of a mesh of "
+       "--quad-surface follows from its quads",
+       "drop --target-hexes, or give a finer or coarser quad surface"},
+      {quads, {"--target-hexes", "2500"}, "--target-hexes 2500 sets the size", ""},  // the default
+      {quads,
+       {"--landmarks", landmarks},
+       "--landmarks " + landmarks + " places the mandible quad template on a SURFACE",
+       "drop --landmarks, or give them to hexbite quad from-mandible"},
+      {quads,
+       {"--units", "cm"},
+       "--units cm is the length unit of the SURFACE file (converted to mm), but a --quad-surface is meshed "
+       "in its own coordinates",
+       "drop --units, or give it to hexbite quad from-mandible"},
+      {quads, {"--units", "mm"}, "--units mm is the length unit", ""},  // the default
+      {quads, {"--core", "swept"}, "--core swept chooses the core of --method grid", "use --method grid"},
+      {grid,
+       {"--core", "swept", "--margin", "0.1"},
+       "--margin 0.1 chooses the core cells of the overlay grid, but --core swept takes columns",
+       "drop --margin, or use --core grid"},
+      {grid,
+       {"--core", "swept", "--grid-frame", "axes"},
+       "--core swept sweeps the core across the dental arch, so it needs --grid-frame arch",
+       "drop --grid-frame axes, or use --core grid"},
+      {quads,
+       {"--refine-at", "1,2,3"},
+       "--refine-at 1,2,3 refines the quad surface that --method sheets places on a mandible SURFACE, but a "
+       "--quad-surface is meshed as it is",
+       "drop --refine-at, or run --method sheets on the SURFACE"}};
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"mesh", "-o", dir + "/m.vtu"};
+    args.insert(args.end(), c.path.begin(), c.path.end());
+    args.insert(args.end(), c.option.begin(), c.option.end());
+    const auto r = test::run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 2) << c.message << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.advice), std::string::npos) << r.err;
+    EXPECT_FALSE(std::ifstream(dir + "/m.vtu").good()) << c.message;
+  }
+  // The defaults are not given: each path meshes with them, and with the options that it uses.
+  const std::vector<std::vector<std::string>> valid_commands = {
+      grid,
+      quads,
+      {"--method", "grid", dir + "/sphere.stl", "--target-hexes", "200", "--units", "cm", "--landmarks",
+       landmarks},
+      {"--method", "sheets", "--quad-surface", dir + "/cube.obj", "--order", "fewest-hexes"}};
+  for (const std::vector<std::string>& valid : valid_commands) {
+    std::vector<std::string> args = {"mesh", "-o", dir + "/ok.vtu", "--quiet"};
+    args.insert(args.end(), valid.begin(), valid.end());
+    const auto r = test::run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 0) << valid.back() << ": " << r.err;
+    EXPECT_TRUE(std::ifstream(dir + "/ok.vtu").good());
+    std::remove((dir + "/ok.vtu").c_str());
+  }
 }
 
 }  // namespace

@@ -312,7 +312,8 @@ TEST(QuadLocalRefinement, CommandLineRefusesUnknownNamesAndGrid) {
   const test::CommandResult grid = test::run_hexbite(
       {"mesh", jaw, "--method", "grid", "-o", test::temp_dir() + "/m.vtu", "--refine-at", "1,2,3"});
   EXPECT_EQ(grid.exit_code, 2);
-  EXPECT_NE(grid.err.find("--refine-at refines the quad surface"), std::string::npos) << grid.err;
+  EXPECT_NE(grid.err.find("--refine-at 1,2,3 refines the quad surface"), std::string::npos) << grid.err;
+  EXPECT_NE(grid.err.find("--method grid places no quad surface"), std::string::npos) << grid.err;
   const test::CommandResult levels =
       test::run_hexbite({"mesh", jaw, "--method", "sheets", "-o", test::temp_dir() + "/m.vtu", "--refine-at",
                          "1,2,3", "--refine-levels", "9"});

@@ -464,6 +464,27 @@ outputs: {bite_force: false}
   EXPECT_FALSE(fs::exists(dir));
 }
 
+// The same cube with the swept core (which implies the arch frame): refused at the scenario's core.
+TEST(RunScenario, SweptCoreOfABoneWithoutAnArchIsRefusedAtItsLine) {
+  const std::string path = write_scenario(R"(name: cube
+geometry:
+  surface: {file: cube.obj}
+mesh: {target_hexes: 500, validation_levels: 0, core: swept}
+muscles:
+  - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
+supports:
+  - {name: base, at: [0, 10, 10], radius_mm: 5}
+outputs: {bite_force: false}
+)");
+  test::write_file(fs::path(path).parent_path().string() + "/cube.obj", test::cubes_obj(1));
+  const std::string dir = test::temp_dir() + "/out";
+  const test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(path + ":4:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mesh.core swept: arch frame: "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
 // A CT geometry whose threshold every voxel reaches: the surface would be the box of the scan, which
 // used to be meshed and solved as if it were the bone. Refused at the geometry's line, naming the file.
 TEST(RunScenario, CtThresholdBelowEveryVoxelIsRefusedAtTheGeometry) {

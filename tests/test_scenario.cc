@@ -296,6 +296,21 @@ TEST(Scenario, GridFrameIsReadForTheGridMethodOnly) {
                   "mesh.grid_frame lays the overlay grid of method grid, but mesh.method is sheets");
 }
 
+// mesh.core (grid or swept) is read for the grid method only; swept implies the arch frame and contradicts
+// an explicit grid_frame: axes.
+TEST(Scenario, SweptCoreIsReadForTheGridMethodAndImpliesTheArchFrame) {
+  EXPECT_FALSE(load_scenario(write_scenario(kValid)).mesh.swept_core);
+  const Scenario swept = load_scenario(write_scenario(kValid + "mesh: {core: swept}\n"));
+  EXPECT_TRUE(swept.mesh.swept_core);
+  EXPECT_TRUE(swept.mesh.arch_frame);
+  EXPECT_FALSE(load_scenario(write_scenario(kValid + "mesh: {core: grid}\n")).mesh.swept_core);
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {core: octree}\n"), 11, "'octree'");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh:\n  method: sheets\n  core: swept\n"), 13,
+                  "mesh.core chooses the core of method grid, but mesh.method is sheets");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh:\n  grid_frame: axes\n  core: swept\n"), 13,
+                  "mesh.core swept sweeps the core across the dental arch, but mesh.grid_frame is axes");
+}
+
 TEST(ScenarioErrors, RepeatedKey) {
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    activation: 0.6")), 7,

@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "common/error.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_quality.h"
 #include "mesher/mandible_generator.h"
 #include "mesher/surface_check.h"
+#include "mesher/surface_io.h"
 #include "mesher/surface_projector.h"
 #include "mesher/swept_core.h"
 #include "tests/test_shapes.h"
@@ -112,6 +115,21 @@ TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
     EXPECT_LT(std::fabs(c->report.fidelity.volume_difference), 0.05);
     EXPECT_LT(c->report.fidelity.hausdorff, 2.0 * c->report.fidelity.mean_edge_length);
   }
+}
+
+// `hexbite mesh --core swept` meshes along the arch (implied) and says so in its JSON.
+TEST(SweptCore, MeshCommandReportsTheSweptCore) {
+  const std::string dir = test::temp_dir();
+  write_surface(dir + "/m.stl", generate_mandible({}).surface);
+  const auto r = test::run_hexbite(
+      {"mesh", dir + "/m.stl", "--core", "swept", "--target-hexes", "1500", "-o", dir + "/m.vtu", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["core"], "swept");
+  EXPECT_EQ(j["grid_frame"], "arch");
+  EXPECT_EQ(j["grid"][1], 1);
+  EXPECT_EQ(j["inverted"], 0);
+  EXPECT_TRUE(std::ifstream(dir + "/m.vtu").good());
 }
 
 }  // namespace
