@@ -35,12 +35,14 @@ echo "| surface clean | built-in mandible | $(best_of "$hexbite" -q surface clea
 echo "| surface clean | real jaw | $(best_of "$hexbite" -q surface clean "$jaw" -o "$work/clean2.stl") |"
 
 # Meshing (issues 3 and 4): the grid mesher at the paper's coarse size and at 30,000 hexes (also with the
-# grid along the dental arch), the sheet mesher with landmarks, and with the local refinement around a bite
-# point.
+# grid along the dental arch), the swept core at the coarse size, the sheet mesher with landmarks, and with
+# the local refinement around a bite point.
 landmarks=../shared/data/jaw/landmarks.yaml
 for target in 2500 30000; do
   echo "| mesh --method grid --target-hexes $target | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method grid --target-hexes "$target" -o "$work/grid.vtu") |"
 done
+echo "| mesh --core swept --target-hexes 2500 | built-in mandible | $(best_of "$hexbite" -q mesh "$work/jaw.stl" --core swept --target-hexes 2500 -o "$work/swept1.vtu") |"
+echo "| mesh --core swept --target-hexes 2500 | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --core swept --target-hexes 2500 -o "$work/swept2.vtu") |"
 echo "| mesh --method grid --grid-frame arch --target-hexes 30000 | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method grid --grid-frame arch --target-hexes 30000 -o "$work/grid_arch.vtu") |"
 echo "| mesh --method sheets --landmarks | built-in mandible | $(best_of "$hexbite" -q mesh "$work/jaw.stl" --method sheets --landmarks "$work/jaw.yaml" -o "$work/sheets1.vtu") |"
 echo "| mesh --method sheets --landmarks | real jaw | $(best_of "$hexbite" -q mesh "$jaw" --method sheets --landmarks "$landmarks" -o "$work/sheets2.vtu") |"
