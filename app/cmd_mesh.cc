@@ -94,7 +94,8 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << (r.swept ? " (along the arch x layers across x up)" : "") << ", "
-      << r.cells_added_for_manifold << " cells added for a manifold core"
+      << (r.swept ? std::to_string(r.cells_in_dropped_components) + " columns dropped for a manifold core"
+                  : std::to_string(r.cells_added_for_manifold) + " cells added for a manifold core")
       << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string())
       << "\n\n";
   out << phase_table(r.optimize) << '\n';

@@ -1151,6 +1151,7 @@ GridAttempt swept_attempt(const SurfaceProjector& projector, const Vec3& lo, con
   r.swept = true;
   r.cell_size = core.cell_size;
   r.grid = core.grid;
+  r.cells_in_dropped_components = int(core.dropped_columns);
   out.mesh = std::move(core.mesh);
   for (Vec3& v : out.mesh.vertices) v = arch.to_body(v);
   r.core_hexes = int(out.mesh.hexes.size());
@@ -1188,7 +1189,16 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   TriSurface straightened;
   std::unique_ptr<SurfaceProjector> straightened_projector;
   if (options.arch_frame || options.swept_core) {
-    arch.emplace(surface);
+    try {
+      arch.emplace(surface);
+    } catch (const NotAnArchError& e) {
+      if (!options.swept_core) throw;
+      // The arch frame's way out, the axis-aligned grid, is refused with the swept core: name the grid core.
+      const std::string message = e.what();
+      throw NotAnArchError(message.substr(0, message.find("; use the axis-aligned grid")) +
+                           "; the swept core lies along the arch: use the grid core for other solids (--core "
+                           "grid --grid-frame axes, in a scenario core: grid and grid_frame: axes)");
+    }
     straightened = surface;
     for (Vec3& v : straightened.vertices) v = arch->to_arch(v);
     straightened_projector = std::make_unique<SurfaceProjector>(straightened);

@@ -179,7 +179,7 @@ struct GridMeshReport {
   int pillow_hexes = 0;
   bool swept = false;  // the kept core is the swept core (grid: cells along s, layers across, cells along z)
   int cells_added_for_manifold = 0;
-  int cells_in_dropped_components = 0;
+  int cells_in_dropped_components = 0;  // the swept core: columns dropped (SweptCore::dropped_columns)
   // Vertices of the core's boundary quad surface, and those of valence other than 4 among them.
   int core_boundary_vertices = 0;
   int irregular_core_boundary_vertices = 0;

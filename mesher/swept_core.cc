@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,50 +41,9 @@ struct Layout {
   int ns = 0, nz = 0;
   std::vector<Interval> centre;  // per cell, at its centre
   std::vector<char> selected;
-  long columns = 0, outline_edges = 0;
+  long columns = 0, outline_edges = 0, dropped = 0;
   long cell(int i, int j) const { return long(j) * ns + i; }
 };
-
-// Keeps the largest edge-connected set of selected cells and drops one cell of every pair that meets only
-// at a corner, until neither changes anything.
-void make_manifold(Layout& l) {
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (int j = 0; j + 1 < l.nz; ++j)
-      for (int i = 0; i + 1 < l.ns; ++i) {
-        const long c00 = l.cell(i, j), c10 = c00 + 1, c01 = c00 + l.ns, c11 = c01 + 1;
-        if (l.selected[c00] && l.selected[c11] && !l.selected[c10] && !l.selected[c01])
-          l.selected[c11] = 0, changed = true;
-        if (l.selected[c10] && l.selected[c01] && !l.selected[c00] && !l.selected[c11])
-          l.selected[c01] = 0, changed = true;
-      }
-    std::vector<int> component(l.selected.size(), -1);
-    int largest = -1, count = 0;
-    long largest_size = 0;
-    for (long c = 0; c < long(l.selected.size()); ++c) {
-      if (!l.selected[c] || component[c] >= 0) continue;
-      std::vector<long> stack{c};
-      component[c] = count;
-      long size = 0;
-      while (!stack.empty()) {
-        const long x = stack.back();
-        stack.pop_back();
-        ++size;
-        const int i = int(x % l.ns), j = int(x / l.ns);
-        const int next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
-        for (const auto& n : next) {
-          if (n[0] < 0 || n[0] >= l.ns || n[1] < 0 || n[1] >= l.nz) continue;
-          const long y = l.cell(n[0], n[1]);
-          if (l.selected[y] && component[y] < 0) component[y] = count, stack.push_back(y);
-        }
-      }
-      if (size > largest_size) largest_size = size, largest = count;
-      ++count;
-    }
-    for (long c = 0; c < long(l.selected.size()); ++c)
-      if (l.selected[c] && component[c] != largest) l.selected[c] = 0, changed = true;
-  }
-}
 
 Layout lay_out(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, double h, double shift,
                const SweptCoreOptions& options) {
@@ -101,7 +62,7 @@ Layout lay_out(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi, 
       l.centre[c] = across(surface, l.s0 + (i + 0.5) * h, l.z0 + (j + 0.5) * h, t_lo, t_hi);
       l.selected[c] = l.centre[c].thickness() >= options.min_thickness_cells * h;
     }
-  make_manifold(l);
+  l.dropped = detail::keep_manifold_columns(l.selected, l.ns, l.nz);
   for (int j = 0; j < l.nz; ++j)
     for (int i = 0; i < l.ns; ++i) {
       if (!l.selected[l.cell(i, j)]) continue;
@@ -122,6 +83,7 @@ SweptCore build(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi,
   out.grid = {l.ns, options.layers, l.nz};
   out.columns = l.columns;
   out.outline_edges = l.outline_edges;
+  out.dropped_columns = l.dropped;
   const double t_lo = lo[1] - l.h, t_hi = hi[1] + l.h;
   const int nv = l.ns + 1;
   auto vertex = [nv](int i, int j) { return long(j) * nv + i; };
@@ -170,8 +132,59 @@ SweptCore build(const SurfaceProjector& surface, const Vec3& lo, const Vec3& hi,
 
 }  // namespace
 
+namespace detail {
+
+// The components first: a cell outside the largest set that meets one of it at a corner goes with its own
+// set, instead of taking the largest set's cell with it (the later of the two).
+long keep_manifold_columns(std::vector<char>& selected, int ns, int nz) {
+  long dropped = 0;
+  auto cell = [ns](int i, int j) { return long(j) * ns + i; };
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<int> component(selected.size(), -1);
+    int largest = -1, count = 0;
+    long largest_size = 0;
+    for (long c = 0; c < long(selected.size()); ++c) {
+      if (!selected[c] || component[c] >= 0) continue;
+      std::vector<long> stack{c};
+      component[c] = count;
+      long size = 0;
+      while (!stack.empty()) {
+        const long x = stack.back();
+        stack.pop_back();
+        ++size;
+        const int i = int(x % ns), j = int(x / ns);
+        const int next[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+        for (const auto& n : next) {
+          if (n[0] < 0 || n[0] >= ns || n[1] < 0 || n[1] >= nz) continue;
+          const long y = cell(n[0], n[1]);
+          if (selected[y] && component[y] < 0) component[y] = count, stack.push_back(y);
+        }
+      }
+      if (size > largest_size) largest_size = size, largest = count;
+      ++count;
+    }
+    for (long c = 0; c < long(selected.size()); ++c)
+      if (selected[c] && component[c] != largest) selected[c] = 0, changed = true, ++dropped;
+    for (int j = 0; j + 1 < nz; ++j)
+      for (int i = 0; i + 1 < ns; ++i) {
+        const long c00 = cell(i, j), c10 = c00 + 1, c01 = c00 + ns, c11 = c01 + 1;
+        if (selected[c00] && selected[c11] && !selected[c10] && !selected[c01])
+          selected[c11] = 0, changed = true, ++dropped;
+        if (selected[c10] && selected[c01] && !selected[c00] && !selected[c11])
+          selected[c01] = 0, changed = true, ++dropped;
+      }
+  }
+  return dropped;
+}
+
+}  // namespace detail
+
 SweptCore swept_core(const SurfaceProjector& straightened, const Vec3& lo, const Vec3& hi, long target_hexes,
                      double shift, const SweptCoreOptions& options) {
+  if (options.layers < 1)
+    throw std::invalid_argument("swept_core: layers must be at least 1, got " +
+                                std::to_string(options.layers));
   // Start where a third of the side view's box holds the columns: the secant steps correct it.
   const double target = double(target_hexes);
   const double per_column = options.layers + 2.5;
@@ -198,11 +211,14 @@ SweptCore swept_core(const SurfaceProjector& straightened, const Vec3& lo, const
     prev_total = total;
     h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
   }
-  if (best.columns == 0)
+  if (best.columns == 0) {
+    std::ostringstream thick;
+    thick << options.min_thickness_cells;
     throw InputError(
-        "swept core: no column of the bone's side view holds it a quarter of a cell thick at any "
-        "trial cell size for " +
-        std::to_string(target_hexes) + " hexes; ask for more hexes, or use the grid core (--core grid)");
+        "swept core: no column of the bone's side view holds it " + thick.str() +
+        " cells thick at any trial cell size for " + std::to_string(target_hexes) +
+        " hexes; ask for more hexes, or use the grid core (--core grid; in a scenario core: grid)");
+  }
   return build(straightened, lo, hi, best, options);
 }
 

@@ -23,11 +23,12 @@
 // Limits: the bone must be one interval across the arch at every grid vertex for the core to follow it;
 // where a line crosses the surface more than twice (between tooth crowns) the outermost crossings are used
 // and the column may span a gap, which the pillow layer pulls back inside (SweptCore::split_vertices).
-// Cost: per trial size one segment query per grid vertex and column centre, O((S Z) log T) for an S x Z
-// grid and T triangles.
+// Cost: per trial size one segment query per cell centre of the S x Z grid over the side view's box, and
+// one per grid vertex of the kept grid's columns: O((S Z) log T) per trial for T triangles.
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "mesher/hex_mesh.h"
 #include "mesher/surface_projector.h"
@@ -46,10 +47,19 @@ struct SweptCore {
   long columns = 0;           // selected cells of the (s, z) grid
   long outline_edges = 0;     // edges between a selected and an unselected cell
   int split_vertices = 0;     // grid vertices whose line across the arch crosses the surface 4 or more times
+  long dropped_columns = 0;   // thick enough, but outside the largest set or meeting one only at a corner
 };
 
-// Throws InputError when no column holds the bone at any trial size (bounds that miss the bone).
+// Throws InputError when no column holds the bone at any trial size (bounds that miss the bone), and
+// std::invalid_argument for options.layers < 1.
 SweptCore swept_core(const SurfaceProjector& straightened, const Vec3& lo, const Vec3& hi, long target_hexes,
                      double shift, const SweptCoreOptions& options = {});
+
+namespace detail {
+// The selection rule of swept_core on an ns x nz grid of cells (cell (i, j) at j * ns + i): keeps the largest
+// edge-connected set of selected cells, then drops the later of every two that meet only at a corner, until
+// neither changes anything; returns the number of cells dropped. Exposed for tests.
+long keep_manifold_columns(std::vector<char>& selected, int ns, int nz);
+}  // namespace detail
 
 }  // namespace hexbite

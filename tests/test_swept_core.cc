@@ -7,8 +7,11 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <vector>
 
 #include "common/error.h"
+#include "mesher/arch_frame.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_quality.h"
 #include "mesher/mandible_generator.h"
@@ -75,6 +78,50 @@ TEST(SweptCore, NoColumnAtAnySizeIsRefused) {
     swept_core(surface, {300, 0, 0}, {400, 10, 40}, 500, 0.0);
   });
   EXPECT_NE(message.find("no column of the bone's side view"), std::string::npos) << message;
+}
+
+// A lone cell meeting the largest set of columns at a corner goes with its own set; the largest set keeps
+// its corner cell (before, the corner rule ran first and dropped the later of the two: the largest set's).
+TEST(SweptCore, ALoneCellAtACornerDoesNotTakeTheLargestSetsCell) {
+  // 4 x 3 cells, row j = 0 at the bottom: the lone cell (0, 0) meets (1, 1) of the 2 x 2 block at a corner.
+  std::vector<char> selected = {1, 0, 0, 0,  //
+                                0, 1, 1, 0,  //
+                                0, 1, 1, 0};
+  EXPECT_EQ(detail::keep_manifold_columns(selected, 4, 3), 1);
+  const std::vector<char> kept = {0, 0, 0, 0,  //
+                                  0, 1, 1, 0,  //
+                                  0, 1, 1, 0};
+  EXPECT_EQ(selected, kept);
+  // Two cells of the largest set meeting only at a corner: the later one goes.
+  std::vector<char> corner = {1, 1, 0,  //
+                              1, 0, 1,  //
+                              1, 1, 1};
+  EXPECT_EQ(detail::keep_manifold_columns(corner, 3, 3), 1);
+  // (1, 0) and (2, 1) meet only at a corner, (2, 1) is the later: dropped, the rest stays one set.
+  const std::vector<char> corner_kept = {1, 1, 0,  //
+                                         1, 0, 0,  //
+                                         1, 1, 1};
+  EXPECT_EQ(corner, corner_kept);
+}
+
+// Fewer than one layer across is a caller's error, refused before any hex (before: vertices of NaN, no
+// hexes).
+TEST(SweptCore, FewerThanOneLayerIsRefused) {
+  const SurfaceProjector surface(test::box(100.0, 10.0, 40.0));
+  EXPECT_THROW(swept_core(surface, {0, 0, 0}, {100, 10, 40}, 500, 0.0, {0, 0.25}), std::invalid_argument);
+}
+
+// A solid that follows no arch: the arch frame's way out, --grid-frame axes, is refused with --core swept, so
+// the message names the grid core (before: "use the axis-aligned grid ... (--grid-frame axes)" alone).
+TEST(SweptCore, BoneWithoutAnArchNamesTheGridCore) {
+  GridMeshOptions options;
+  options.target_hexes = 500;
+  options.swept_core = true;
+  const std::string message =
+      test::message_of<NotAnArchError>([&] { grid_mesh(test::torus(48, 24), options); });
+  EXPECT_NE(message.find("arch frame: "), std::string::npos) << message;
+  EXPECT_NE(message.find("--core grid --grid-frame axes"), std::string::npos) << message;
+  EXPECT_EQ(message.find("use the axis-aligned grid"), std::string::npos) << message;
 }
 
 struct Coarse {
