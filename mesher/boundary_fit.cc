@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
+#include <utility>
 
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
@@ -150,6 +152,84 @@ BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& 
   progress.finish();
   for (int v : ids)
     report.max_node_offset = std::max(report.max_node_offset, surface.distance(mesh.vertices[v]));
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surface,
+                                   const FarSurfaceOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FarSurfaceReport report;
+  std::vector<std::vector<int>> hexes_of(mesh.vertices.size());
+  for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+    for (int v : mesh.hexes[e]) hexes_of[v].push_back(static_cast<int>(e));
+  std::vector<HexQuality> quality(mesh.hexes.size());
+  double sj_min = 1.0, kappa_max = 3.0;
+  for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
+    quality[e] = quality_of(mesh, static_cast<int>(e));
+    if (quality[e].inverted && options.keep_worst) return report;  // only valid meshes keep their worst
+    sj_min = std::min(sj_min, quality[e].scaled_jacobian);
+    kappa_max = std::max(kappa_max, quality[e].condition);
+  }
+  const std::vector<Vec3>& samples = surface.surface().vertices;
+  for (int round = 0; round < options.rounds; ++round) {
+    const HexBoundary boundary = extract_boundary(mesh);
+    const QuadSurface& q = boundary.surface;
+    double length = 0.0;
+    long edges = 0;
+    for (const auto& quad : q.quads)
+      for (int k = 0; k < 4; ++k, ++edges)
+        length += norm(sub(q.vertices[quad[k]], q.vertices[quad[(k + 1) % 4]]));
+    const double limit = options.limit * length / double(std::max(1L, edges));
+    const SurfaceProjector boundary_surface(fan_triangles(q));
+    std::vector<std::pair<double, int>> far;  // (distance, surface vertex), farthest first
+    for (std::size_t v = 0; v < samples.size(); ++v) {
+      const double d = boundary_surface.distance(samples[v]);
+      if (d > limit) far.emplace_back(d, static_cast<int>(v));
+    }
+    std::sort(far.rbegin(), far.rend());
+    if (round == 0) report.far_vertices = static_cast<int>(far.size());
+    std::vector<char> used(mesh.vertices.size(), 0);
+    int moved = 0;
+    for (const auto& [distance, sample] : far) {
+      const Vec3& p = samples[sample];
+      int node = -1;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int v : boundary.boundary_vertices) {
+        const double d = norm(sub(mesh.vertices[v], p));
+        if (d < nearest) nearest = d, node = v;
+      }
+      if (node < 0 || used[node]) continue;
+      used[node] = 1;
+      const Vec3 old = mesh.vertices[node];
+      Vec3 step = sub(p, old);
+      bool accepted = false;
+      for (int halving = 0; halving < 5 && !accepted; ++halving, step = scale(step, 0.5)) {
+        mesh.vertices[node] = add(old, step);
+        accepted = true;
+        for (int e : hexes_of[node]) {
+          const HexQuality h = quality_of(mesh, e);
+          const bool pass =
+              options.keep_worst
+                  ? !h.inverted && h.scaled_jacobian >= std::min(quality[e].scaled_jacobian, sj_min) &&
+                        h.condition <= std::max(quality[e].condition, kappa_max)
+                  : h.scaled_jacobian >= std::min(quality[e].scaled_jacobian, options.min_scaled_jacobian);
+          if (!pass) {
+            accepted = false;
+            break;
+          }
+        }
+      }
+      if (!accepted) {
+        mesh.vertices[node] = old;
+        continue;
+      }
+      for (int e : hexes_of[node]) quality[e] = quality_of(mesh, e);
+      ++moved;
+    }
+    report.moved_nodes += moved;
+    if (moved == 0) break;
+  }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

@@ -51,6 +51,39 @@ BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& 
                                          const std::vector<char>& fixed,
                                          const BoundaryFitOptions& options = {});
 
+// Reaching the surface's tips: moves boundary nodes onto the surface points farthest from the boundary.
+//
+// Why: a coarse mesh's boundary nodes sample the surface only at its nodes; a knob narrower than a few edges
+// (the condyle's lateral pole, the coronoid's tip) lies between them and the quads cut under it, and the
+// optimizer's quality stages slide the nodes farther off (the swept core at 2,500 hexes: the built-in
+// mandible's condyle poles 2.0 mm from the mesh after the pillow layer, 4-5 mm after the optimizer).
+// Input: a hex mesh, the surface it fills, options.
+// Output: moved nodes. Each round measures the distance of every surface vertex to the boundary (fan
+// triangles of the quads); from the farthest down, each vertex farther than options.limit mean boundary
+// edges moves its nearest boundary node (each node once a round) onto it; a move is halved up to four times
+// until the hexes around the node pass the rule, else dropped. With keep_worst the rule is the volume fit's:
+// every hex keeps its scaled Jacobian at least the smaller of its own and the mesh's minimum and its
+// condition number at most the larger of its own and the mesh's maximum (a mesh with an inverted hex is left
+// unchanged); without it (before the optimizer, which untangles and improves what the moves spoil) no hex
+// falls below the smaller of its own scaled Jacobian and min_scaled_jacobian.
+// Cost: per round one closest-point query per surface vertex against the boundary, and a scan of the boundary
+// nodes per far vertex, O(V log Q + F B) for V surface vertices, Q quads, F far vertices, B boundary nodes.
+struct FarSurfaceOptions {
+  double limit = 0.5;  // surface vertices farther than this many mean boundary edges from the boundary pull
+  int rounds = 5;      // rounds (stops early when no node moves)
+  bool keep_worst = true;
+  double min_scaled_jacobian = 0.05;  // without keep_worst
+};
+
+struct FarSurfaceReport {
+  int far_vertices = 0;  // surface vertices farther than the limit in the first round
+  int moved_nodes = 0;   // moves over all rounds
+  double seconds = 0;
+};
+
+FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surface,
+                                   const FarSurfaceOptions& options = {});
+
 // One line for the text reports: "2016 of 2144 boundary nodes moved along their normals (...)".
 std::string describe(const BoundaryFitReport& fit);
 

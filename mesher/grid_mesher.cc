@@ -1160,11 +1160,19 @@ GridAttempt swept_attempt(const SurfaceProjector& projector, const Vec3& lo, con
 }
 
 // Steps 3 and 4 of one grid: the pillow layer and the optimization.
+// With reach_far > 0 the pillow layer's nodes are first moved onto the surface's tips (reach_far_surface,
+// validity only: the optimizer improves what the moves spoil, and starts from there).
 void pillow_and_optimize(GridAttempt& attempt, const SurfaceProjector& projector,
-                         const OptimizeOptions& optimize) {
+                         const OptimizeOptions& optimize, double reach_far) {
   GridMeshReport& r = attempt.report;
   auto t0 = std::chrono::steady_clock::now();
   r.pillow_hexes = add_pillow_layer(attempt.mesh, projector, attempt.selection.grid.h);
+  if (reach_far > 0) {
+    FarSurfaceOptions far;
+    far.limit = reach_far;
+    far.keep_worst = false;
+    reach_far_surface(attempt.mesh, projector, far);
+  }
   r.seconds_pillow = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -1245,6 +1253,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   per_grid.mean_jacobian_sweeps = 0;
   OptimizeOptions per_swept = per_grid;
   per_swept.boundary_tether = options.swept_tether;
+  per_swept.max_iterations = options.swept_newton_sweeps;
   // The attempts: with coarse cells the plain core on each grid. With fine cells the plain core
   // (fine_margin, the cells whose centre lies inside) on the unshifted and the half-shifted grid, and the
   // thick-margin core (thin plates keep their cells) on the half- and the quarter-shifted grid: the plain
@@ -1281,7 +1290,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
       else if (a > 0)
         attempts[a] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
                                 jobs[a].shift, jobs[a].rule, arch_frame);
-      pillow_and_optimize(attempts[a], projector, jobs[a].rule == CoreRule::kSwept ? per_swept : per_grid);
+      const bool swept_job = jobs[a].rule == CoreRule::kSwept;
+      pillow_and_optimize(attempts[a], projector, swept_job ? per_swept : per_grid,
+                          swept_job ? options.swept_reach_far : 0.0);
     } catch (...) {
       errors[a] = std::current_exception();
     }
@@ -1376,6 +1387,18 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     final_phase.quality = summarize_quality(mesh);
     final_phase.seconds += seconds_since(t0);
     report.optimize.energy_after = condition_energy(mesh, nullptr);
+    report.seconds_optimize += seconds_since(t0);
+  }
+  if (swept && options.swept_reach_far > 0 && report.optimize.inverted == 0) {
+    // The swept core's tips again, after the optimizer and the mean stage moved the nodes: the worst element
+    // never worse.
+    t0 = std::chrono::steady_clock::now();
+    FarSurfaceOptions far;
+    far.limit = options.swept_reach_far;
+    reach_far_surface(mesh, projector, far);
+    PhaseQuality& final_phase = report.optimize.phases.back();
+    final_phase.quality = summarize_quality(mesh);
+    final_phase.seconds += seconds_since(t0);
     report.seconds_optimize += seconds_since(t0);
   }
   if (options.fit_volume && report.optimize.inverted == 0) {

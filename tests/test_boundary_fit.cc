@@ -52,6 +52,31 @@ double largest_boundary_edge(const HexMesh& mesh) {
   return longest;
 }
 
+// reach_far_surface with keep_worst: the Hausdorff distance of the grid mesh falls, the worst element is no
+// worse, nothing inverts, and a second call finds less to do.
+TEST(BoundaryFit, ReachingTheFarSurfaceKeepsTheWorstElement) {
+  const Meshed& m = mandible_mesh();
+  const SurfaceProjector surface(m.mandible.surface);
+  HexMesh mesh = m.mesh;
+  const MeshFidelity before = measure_fidelity(mesh, surface);
+  const QualitySummary q0 = summarize_quality(mesh);
+  ASSERT_EQ(q0.inverted, 0);
+  FarSurfaceOptions options;
+  options.limit = 0.3;
+  const FarSurfaceReport report = reach_far_surface(mesh, surface, options);
+  const QualitySummary q1 = summarize_quality(mesh);
+  const MeshFidelity after = measure_fidelity(mesh, surface);
+  EXPECT_GT(report.far_vertices, 0);
+  EXPECT_GT(report.moved_nodes, 0);
+  EXPECT_EQ(q1.inverted, 0);
+  EXPECT_GE(q1.scaled_jacobian.min, q0.scaled_jacobian.min - 1e-12);
+  EXPECT_LE(q1.condition.max, q0.condition.max + 1e-9);
+  EXPECT_LE(after.hausdorff_surface_to_mesh, before.hausdorff_surface_to_mesh + 1e-9);
+  EXPECT_EQ(mesh.hexes, m.mesh.hexes);
+  HexMesh again = mesh;
+  EXPECT_LT(reach_far_surface(again, surface, options).far_vertices, report.far_vertices);
+}
+
 TEST(BoundaryFit, MatchesTheMandiblesVolumeWithoutWorseElements) {
   const Meshed& m = mandible_mesh();
   const SurfaceProjector surface(m.mandible.surface);

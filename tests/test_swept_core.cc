@@ -143,10 +143,11 @@ Coarse mesh_swept(const TriSurface& surface) {
 
 // Issue 3's coarse element targets (0 inverted, scaled Jacobian min >= 0.3 and mean >= 0.85, kappa max <= 10
 // at about 2,500 hexes), which the overlay grid misses on both bones (means 0.79 / 0.76 along the axes,
-// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-22: built-in mandible 2,512 hexes, 0.563 /
-// 0.907, kappa 5.99; real jaw 2,497 hexes, 0.448 / 0.895, kappa 7.58. The fidelity is what the swept core
-// gives up: the built-in mandible's condyle poles lie 4-5 mm from the mesh (Hausdorff 1.71 mean edges
-// against 0.64 along the axes), and neither bone's volume is within 3 % (-4.45 / -4.53 %).
+// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-22 (no Newton sweeps, the tips reached):
+// built-in mandible 2,512 hexes, 0.569 / 0.904, kappa 5.99, Hausdorff 1.07 mean edges, volume -3.97 %; real
+// jaw 2,546 hexes, 0.421 / 0.891, kappa 9.26, 0.88 mean edges, -3.65 %. The fidelity is what the swept
+// core gives up (1.71 / 1.49 mean edges before the tips were reached; 0.64 along the axes), and neither
+// bone's volume is within 3 % without --fit-volume.
 TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
   const Coarse m = mesh_swept(generate_mandible({}).surface);
   const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
@@ -158,9 +159,9 @@ TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
     EXPECT_EQ(c->quality.inverted, 0);
     EXPECT_GE(c->quality.scaled_jacobian.min, 0.4);
     EXPECT_GE(c->quality.scaled_jacobian.mean, 0.88);
-    EXPECT_LE(c->quality.condition.max, 8.0);
-    EXPECT_LT(std::fabs(c->report.fidelity.volume_difference), 0.05);
-    EXPECT_LT(c->report.fidelity.hausdorff, 2.0 * c->report.fidelity.mean_edge_length);
+    EXPECT_LE(c->quality.condition.max, 9.6);
+    EXPECT_LT(std::fabs(c->report.fidelity.volume_difference), 0.045);
+    EXPECT_LT(c->report.fidelity.hausdorff, 1.25 * c->report.fidelity.mean_edge_length);
   }
 }
 
