@@ -45,6 +45,25 @@ HexQuality quality_of(const HexMesh& mesh, int e) {
   return hex_quality(x);
 }
 
+// What both boundary passes check their moves against: each node's hexes, each hex's quality, and the
+// mesh's smallest scaled Jacobian and largest condition number.
+struct LocalQuality {
+  std::vector<std::vector<int>> hexes_of;
+  std::vector<HexQuality> quality;
+  double sj_min = 1.0, kappa_max = 3.0;
+  bool inverted = false;  // some hex is inverted
+
+  explicit LocalQuality(const HexMesh& mesh) : hexes_of(mesh.vertices.size()), quality(mesh.hexes.size()) {
+    for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
+      for (int v : mesh.hexes[e]) hexes_of[v].push_back(static_cast<int>(e));
+      quality[e] = quality_of(mesh, static_cast<int>(e));
+      inverted = inverted || quality[e].inverted;
+      sj_min = std::min(sj_min, quality[e].scaled_jacobian);
+      kappa_max = std::max(kappa_max, quality[e].condition);
+    }
+  }
+};
+
 }  // namespace
 
 BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& surface,
@@ -57,17 +76,9 @@ BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& 
   const std::size_t nb = ids.size();
   report.boundary_nodes = static_cast<int>(nb);
 
-  std::vector<std::vector<int>> hexes_of(mesh.vertices.size());
-  for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-    for (int v : mesh.hexes[e]) hexes_of[v].push_back(static_cast<int>(e));
-  std::vector<HexQuality> quality(mesh.hexes.size());
-  double sj_min = 1.0, kappa_max = 3.0;
-  for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
-    quality[e] = quality_of(mesh, static_cast<int>(e));
-    sj_min = std::min(sj_min, quality[e].scaled_jacobian);
-    kappa_max = std::max(kappa_max, quality[e].condition);
-    if (quality[e].inverted) return report;  // only valid meshes are fitted
-  }
+  LocalQuality local(mesh);
+  if (local.inverted) return report;  // only valid meshes are fitted
+  auto& [hexes_of, quality, sj_min, kappa_max, inverted] = local;
   // Mean boundary edge length per node, for the offset limit.
   std::vector<double> edge(nb, 0.0);
   std::vector<int> edge_count(nb, 0);
@@ -160,17 +171,9 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
                                    const FarSurfaceOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   FarSurfaceReport report;
-  std::vector<std::vector<int>> hexes_of(mesh.vertices.size());
-  for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-    for (int v : mesh.hexes[e]) hexes_of[v].push_back(static_cast<int>(e));
-  std::vector<HexQuality> quality(mesh.hexes.size());
-  double sj_min = 1.0, kappa_max = 3.0;
-  for (std::size_t e = 0; e < mesh.hexes.size(); ++e) {
-    quality[e] = quality_of(mesh, static_cast<int>(e));
-    if (quality[e].inverted && options.keep_worst) return report;  // only valid meshes keep their worst
-    sj_min = std::min(sj_min, quality[e].scaled_jacobian);
-    kappa_max = std::max(kappa_max, quality[e].condition);
-  }
+  LocalQuality local(mesh);
+  if (local.inverted && options.keep_worst) return report;  // only valid meshes keep their worst
+  auto& [hexes_of, quality, sj_min, kappa_max, inverted] = local;
   const std::vector<Vec3>& samples = surface.surface().vertices;
   for (int round = 0; round < options.rounds; ++round) {
     const HexBoundary boundary = extract_boundary(mesh);
