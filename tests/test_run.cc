@@ -443,12 +443,14 @@ outputs: {bite_force: false}
   EXPECT_LT(j["equilibrium_residual"].get<double>(), 1e-8);
 }
 
-// A grid along the dental arch of a bone that follows no arch (a cube): refused at the scenario's grid_frame.
-TEST(RunScenario, GridFrameArchOfABoneWithoutAnArchIsRefusedAtItsLine) {
+// A bone that follows no arch (a cube) with a mesh setting that needs the arch: refused at that setting's
+// line (4), with `expected` in the message, and nothing written.
+void expect_cube_refused_for_its_arch(const std::string& mesh_key, const std::string& expected) {
   const std::string path = write_scenario(R"(name: cube
 geometry:
   surface: {file: cube.obj}
-mesh: {target_hexes: 500, validation_levels: 0, grid_frame: arch}
+mesh: {target_hexes: 500, validation_levels: 0, )" +
+                                          mesh_key + R"(}
 muscles:
   - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
 supports:
@@ -460,29 +462,17 @@ outputs: {bite_force: false}
   const test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(path + ":4:"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("mesh.grid_frame arch: arch frame: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir));
 }
 
-// The same cube with the swept core (which implies the arch frame): refused at the scenario's core.
+TEST(RunScenario, GridFrameArchOfABoneWithoutAnArchIsRefusedAtItsLine) {
+  expect_cube_refused_for_its_arch("grid_frame: arch", "mesh.grid_frame arch: arch frame: ");
+}
+
+// The swept core implies the arch frame: refused at the scenario's core.
 TEST(RunScenario, SweptCoreOfABoneWithoutAnArchIsRefusedAtItsLine) {
-  const std::string path = write_scenario(R"(name: cube
-geometry:
-  surface: {file: cube.obj}
-mesh: {target_hexes: 500, validation_levels: 0, core: swept}
-muscles:
-  - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
-supports:
-  - {name: base, at: [0, 10, 10], radius_mm: 5}
-outputs: {bite_force: false}
-)");
-  test::write_file(fs::path(path).parent_path().string() + "/cube.obj", test::cubes_obj(1));
-  const std::string dir = test::temp_dir() + "/out";
-  const test::CommandResult r = test::run_hexbite({"-q", "run", path, "-o", dir});
-  EXPECT_EQ(r.exit_code, 2) << r.err;
-  EXPECT_NE(r.err.find(path + ":4:"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("mesh.core swept: arch frame: "), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(dir));
+  expect_cube_refused_for_its_arch("core: swept", "mesh.core swept: arch frame: ");
 }
 
 // A CT geometry whose threshold every voxel reaches: the surface would be the box of the scan, which
