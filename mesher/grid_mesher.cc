@@ -1065,6 +1065,8 @@ enum class CoreRule {
   // fine cells: the plain core, less deep cells (regular_margin) where the solid is thick, regularized
   kRegular,
   kSwept,  // coarse cells along the arch: the core swept across the arch (mesher/swept_core.h)
+  // the swept core's retry: the optimizer with its Newton sweeps and no tips pass before it
+  kSweptNewton,
 };
 
 // Steps 1 and 2 of one grid, shifted by `shift` cells: the cell size and the core (`mesh` holds the core).
@@ -1254,6 +1256,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   OptimizeOptions per_swept = per_grid;
   per_swept.boundary_tether = options.swept_tether;
   per_swept.max_iterations = options.swept_newton_sweeps;
+  OptimizeOptions per_swept_newton = per_swept;
+  per_swept_newton.max_iterations = per_grid.max_iterations;
   // The attempts: with coarse cells the plain core on each grid. With fine cells the plain core
   // (fine_margin, the cells whose centre lies inside) on the unshifted and the half-shifted grid, and the
   // thick-margin core (thin plates keep their cells) on the half- and the quarter-shifted grid: the plain
@@ -1285,14 +1289,18 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   std::vector<std::exception_ptr> errors(4 + 2);
   auto run_job = [&](int a) {
     try {
-      if (a > 0 && jobs[a].rule == CoreRule::kSwept)
+      const bool swept_job = jobs[a].rule == CoreRule::kSwept || jobs[a].rule == CoreRule::kSweptNewton;
+      if (a > 0 && swept_job)
         attempts[a] = swept_attempt(grid_projector, lo, hi, options, jobs[a].shift, *arch);
       else if (a > 0)
         attempts[a] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
                                 jobs[a].shift, jobs[a].rule, arch_frame);
-      const bool swept_job = jobs[a].rule == CoreRule::kSwept;
-      pillow_and_optimize(attempts[a], projector, swept_job ? per_swept : per_grid,
-                          swept_job ? options.swept_reach_far : 0.0);
+      const CoreRule rule = jobs[a].rule;
+      pillow_and_optimize(attempts[a], projector,
+                          rule == CoreRule::kSwept         ? per_swept
+                          : rule == CoreRule::kSweptNewton ? per_swept_newton
+                                                           : per_grid,
+                          rule == CoreRule::kSwept ? options.swept_reach_far : 0.0);
     } catch (...) {
       errors[a] = std::current_exception();
     }
@@ -1356,7 +1364,15 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   // 0.19 at best with the fine cores, 0.352 / 0.306 with margin everywhere on the half- / quarter-shifted
   // grid), so they are tried too and the best of all kept. Only the shifted grids (the unshifted one gave
   // the jaw 0.199): two attempts are one round in two threads, three were two.
-  if (attempts[0].fine && worst_of(best) < options.retry_below) {
+  const auto inverted_of = [&](int a) { return attempts[a].report.optimize.phases.back().quality.inverted; };
+  if (swept && options.swept_reach_far > 0 && inverted_of(best) > 0) {
+    // The swept retry: on short, wide rami (40 mm in a 75 mm arch, the generator's extreme corners) the swept
+    // core without Newton sweeps can keep pillow hexes inverted (2 at 2,500 or 3,000 hexes), where its first
+    // version, the Newton sweeps on and no tips pass before them, was valid: both grids again that way.
+    std::vector<Job> add;
+    for (int a = 0; a < std::min(grids, 2); ++a) add.push_back({shifts[a], CoreRule::kSweptNewton});
+    retry(add);
+  } else if (attempts[0].fine && worst_of(best) < options.retry_below) {
     std::vector<Job> add;
     for (int a = std::min(1, grids - 1); a < grids; ++a) add.push_back({shifts[a], CoreRule::kMargin});
     retry(add);

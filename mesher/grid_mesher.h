@@ -37,7 +37,8 @@
 //      shifted grids again with margin everywhere (attempts = 6); where another attempt reaches
 //      mean_tie_break but the regular core does not, the regular core on the other two grids (attempts = 6);
 //      With GridMeshOptions::swept_core the attempts are instead the core swept across the arch
-//      (mesher/swept_core.h), unshifted and shifted by half a cell;
+//      (mesher/swept_core.h), unshifted and shifted by half a cell; where the better keeps an inverted hex,
+//      both again with the optimizer's Newton sweeps and no tips pass (attempts = 4);
 //   6. on the kept mesh only, improve_mean_jacobian raises the mean scaled Jacobian without lowering that
 //      measure (no hex below the smaller of its own value and the mesh's smallest scaled Jacobian; boundary
 //      nodes sliding within worst_element_reach of where the pillow layer put them).

@@ -165,6 +165,24 @@ TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
   }
 }
 
+// A corner of the generator's ranges (a 40 mm ramus in a 75 mm arch, 8 mm body): the swept core without
+// Newton sweeps keeps 2 pillow hexes inverted at 2,500 hexes on both grids (measured), so the retry meshes
+// both grids again with the first version's optimization (Newton sweeps, no tips pass), which is valid.
+TEST(SweptCore, InvertedHexesRetryWithNewtonSweeps) {
+  MandibleParameters corner;
+  corner.arch_width_mm = 75;
+  corner.arch_depth_mm = 40;
+  corner.body_height_mm = 8;
+  corner.body_thickness_mm = 8;
+  corner.ramus_height_mm = 40;
+  corner.ramus_width_mm = 40;
+  corner.gonial_angle_deg = 140;
+  const Coarse c = mesh_swept(generate_mandible(corner).surface);
+  EXPECT_EQ(c.report.attempts, 4);
+  EXPECT_EQ(c.quality.inverted, 0);
+  EXPECT_GT(c.quality.scaled_jacobian.min, 0.1);
+}
+
 // `hexbite mesh --core swept` meshes along the arch (implied) and says so in its JSON.
 TEST(SweptCore, MeshCommandReportsTheSweptCore) {
   const std::string dir = test::temp_dir();
