@@ -17,6 +17,7 @@
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/arch_frame.h"
+#include "mesher/cell_size_search.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality_kernel.h"
 #include "mesher/surface_projector.h"
@@ -1085,7 +1086,7 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, c
   double h = std::cbrt(volume / target);
   Selection& best = out.selection;
   double best_error = kInf;
-  double prev_h = 0, prev_total = 0;
+  CellSizeSearch size_search(target, -2.5, -1.0);
   for (int step = 0; step < 8; ++step) {
     const bool fine = options.thick_margin_cells * h <= mean_thickness;
     CoreSelection how;
@@ -1111,14 +1112,7 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, c
     progress.update(double(step + 1) / 8,
                     "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
     if (best_error < 0.02) break;
-    double slope = -2.5;
-    if (prev_total > 0 && total > 0 && prev_h != h) {
-      const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
-      if (fitted < -1.0 && fitted > -4.0) slope = fitted;
-    }
-    prev_h = h;
-    prev_total = total;
-    h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
+    h = size_search.next(h, total);
   }
   progress.finish();
   if (best.core_cells == 0)

@@ -10,6 +10,7 @@
 
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/cell_size_search.h"
 
 namespace hexbite {
 
@@ -192,7 +193,8 @@ SweptCore swept_core(const SurfaceProjector& straightened, const Vec3& lo, const
   Progress progress("swept core");
   Layout best;
   double best_error = std::numeric_limits<double>::infinity();
-  double prev_h = 0, prev_total = 0;
+  // The count falls like h^-2 (columns) to h^-1 (outline); start from the slope -2.
+  CellSizeSearch size_search(target, -2.0, -0.5);
   for (int step = 0; step < 8; ++step) {
     Layout l = lay_out(straightened, lo, hi, h, shift, options);
     const double total = double(l.columns * (options.layers + 2) + l.outline_edges * options.layers);
@@ -201,15 +203,7 @@ SweptCore swept_core(const SurfaceProjector& straightened, const Vec3& lo, const
     progress.update(double(step + 1) / 8,
                     "h = " + std::to_string(h) + " mm, " + std::to_string(long(total)) + " hexes");
     if (best_error < 0.02) break;
-    // The count falls like h^-2 (columns) to h^-1 (outline); start from the slope -2.
-    double slope = -2.0;
-    if (prev_total > 0 && total > 0 && prev_h != h) {
-      const double fitted = std::log(total / prev_total) / std::log(h / prev_h);
-      if (fitted < -0.5 && fitted > -4.0) slope = fitted;
-    }
-    prev_h = h;
-    prev_total = total;
-    h *= total > 0 ? std::pow(target / total, 1.0 / slope) : 0.5;
+    h = size_search.next(h, total);
   }
   if (best.columns == 0) {
     std::ostringstream thick;
