@@ -17,6 +17,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -27,6 +28,7 @@
 #include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/auto_core.h"
 #include "mesher/boundary_fit.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
@@ -47,8 +49,8 @@ struct MeshOptions {
   bool json = false;
   bool allow_invalid = false;
   bool fit_volume = false;
-  std::string grid_frame = "axes";           // --method grid: axes or arch (mesher/arch_frame.h)
-  std::string core = "grid";                 // --method grid: grid or swept (mesher/swept_core.h)
+  std::string grid_frame = "axes";  // --method grid: axes or arch (mesher/arch_frame.h)
+  std::string core = "grid";  // --method grid: grid, swept (mesher/swept_core.h) or auto (mesher/auto_core.h)
   double margin = GridMeshOptions{}.margin;  // given: that margin everywhere, on three grids
   std::string quad_surface;                  // --method sheets
   std::string order = "geometric";           // --method sheets
@@ -85,20 +87,33 @@ std::string phase_table(const OptimizeReport& r) {
   return out.str();
 }
 
-std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r) {
+// The frame of the kept grid: the swept core's is the arch's (--core auto may keep it with --grid-frame
+// axes).
+std::string grid_frame_used(const MeshOptions& o, const GridMeshReport& r) {
+  return r.swept ? "arch" : o.grid_frame;
+}
+
+// --core auto's line: which core it kept, and why when not simply the swept one.
+std::string auto_core_line(const AutoCoreChoice& choice) {
+  return std::string("--core auto kept the ") + (choice.swept ? "swept" : "grid") + " core" +
+         (choice.reason.empty() ? "" : " (" + choice.reason + ")");
+}
+
+std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
+                        const std::optional<AutoCoreChoice>& choice) {
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
-  out << "Meshed " << o.surface << " (grid + pillow" << (o.grid_frame == "arch" ? ", along the arch" : "")
-      << (r.swept ? ", swept core" : "") << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes
-      << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
-      << "\n";
+  out << "Meshed " << o.surface << " (grid + pillow"
+      << (grid_frame_used(o, r) == "arch" ? ", along the arch" : "") << (r.swept ? ", swept core" : "")
+      << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes << " core + " << r.pillow_hexes
+      << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << (r.swept ? " (along the arch x layers across x up)" : "") << ", "
       << (r.swept ? std::to_string(r.cells_in_dropped_components) + " columns dropped for a manifold core"
                   : std::to_string(r.cells_added_for_manifold) + " cells added for a manifold core")
-      << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string())
-      << "\n\n";
-  out << phase_table(r.optimize) << '\n';
+      << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string()) << "\n";
+  if (choice) out << auto_core_line(*choice) << '\n';
+  out << '\n' << phase_table(r.optimize) << '\n';
   out << "optimizer: " << r.optimize.untangle_sweeps << " untangling sweeps, " << r.optimize.iterations
       << " Newton sweeps in " << r.optimize.rounds << " rounds; sum of squared condition numbers "
       << fmt("%.6g", r.optimize.energy_before) << " -> " << fmt("%.6g", r.optimize.energy_after) << '\n';
@@ -119,7 +134,8 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   return out.str();
 }
 
-nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r, bool written) {
+nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const GridMeshReport& r,
+                           const std::optional<AutoCoreChoice>& choice, bool written) {
   nlohmann::json j;
   j["surface"] = o.surface;
   j["method"] = o.method;
@@ -133,8 +149,10 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["cells_added_for_manifold"] = r.cells_added_for_manifold;
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
   j["grid_attempts"] = r.attempts;
-  j["grid_frame"] = o.grid_frame;
+  j["grid_frame"] = grid_frame_used(o, r);
   j["core"] = r.swept ? "swept" : "grid";
+  j["core_requested"] = o.core;
+  if (choice) j["core_reason"] = choice->reason;
   j["landmarks"] = o.landmarks.empty() ? nlohmann::json() : nlohmann::json(o.landmarks);
   nlohmann::json phases = nlohmann::json::array();
   for (const PhaseQuality& p : r.optimize.phases)
@@ -246,7 +264,12 @@ void run_mesh(const MeshOptions& o) {
   // An explicit margin is a request for that core: no automatic choice of cores for fine cells.
   if (o.was_given("--margin")) options.thick_margin_cells = std::numeric_limits<double>::infinity();
   GridMeshReport report;
-  const HexMesh mesh = grid_mesh(surface, options, &report);
+  std::optional<AutoCoreChoice> choice;
+  HexMesh mesh;
+  if (o.core == "auto")
+    mesh = grid_mesh_auto_core(surface, options, &report, &choice.emplace());
+  else
+    mesh = grid_mesh(surface, options, &report);
   if (landmarks) name_unresolved_parts(*landmarks, report.fidelity.unresolved);
   const QualitySummary& final_quality = report.optimize.phases.back().quality;
   const bool valid = final_quality.inverted == 0;
@@ -254,9 +277,9 @@ void run_mesh(const MeshOptions& o) {
   if (write) write_vtu(o.output, mesh);
 
   if (o.json)
-    std::cout << report_json(o, mesh, report, write).dump(2) << '\n';
+    std::cout << report_json(o, mesh, report, choice, write).dump(2) << '\n';
   else if (!is_quiet())
-    std::cout << report_text(o, mesh, report);
+    std::cout << report_text(o, mesh, report, choice);
   if (!valid) {
     const std::string list = hex_list_text(mesh, final_quality.inverted_hexes);
     if (o.allow_invalid) {
@@ -266,7 +289,7 @@ void run_mesh(const MeshOptions& o) {
     }
     throw RunError(std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " +
                    list + "; no mesh written (--allow-invalid writes it anyway" +
-                   (options.swept_core   ? "; the grid core, --core grid, may mesh it valid)"
+                   (report.swept         ? "; the grid core, --core grid, may mesh it valid)"
                     : options.arch_frame ? "; the axis-aligned grid, --grid-frame axes, may mesh it valid)"
                                          : ")"));
   }
@@ -313,11 +336,13 @@ void add_mesh_command(CLI::App& app) {
       ->check(CLI::IsMember({"axes", "arch"}))
       ->capture_default_str();
   cmd->add_option("--core", o->core,
-                  "Core of --method grid: grid (cells of the overlay grid), or swept (a grid over the "
+                  "Core of --method grid: grid (cells of the overlay grid), swept (a grid over the "
                   "bone's side view swept across the dental arch, one hex across the bone per column: "
-                  "better shaped coarse meshes of a whole mandible; implies --grid-frame arch; "
-                  "docs/meshing.md)")
-      ->check(CLI::IsMember({"grid", "swept"}))
+                  "better shaped coarse meshes of a whole mandible; implies --grid-frame arch), or auto "
+                  "(swept up to 10,000 target hexes, the grid core in --grid-frame where the surface follows "
+                  "no arch or the swept mesh misses scaled Jacobian 0.3 or condition number 10, and above "
+                  "10,000; docs/meshing.md)")
+      ->check(CLI::IsMember({"grid", "swept", "auto"}))
       ->capture_default_str();
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "Move the boundary nodes off the SURFACE along their normals until the "

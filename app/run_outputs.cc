@@ -302,6 +302,7 @@ json results_json(const RunResult& r, double seconds_output) {
                {"degree", s.solver.degree},
                {"quality", quality_to_json(coarse.quality)},
                {"fidelity", fidelity_to_json(r.fidelity)}};
+  if (!r.mesh_core.empty()) j["mesh"]["core"] = r.mesh_core;
   json muscles = json::array();
   for (std::size_t i = 0; i < coarse.muscle_patches.size(); ++i)
     muscles.push_back({{"name", coarse.muscle_patches[i].name},

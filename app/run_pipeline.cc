@@ -15,6 +15,7 @@
 #include "common/progress.h"
 #include "common/system_memory.h"
 #include "mesher/arch_frame.h"
+#include "mesher/auto_core.h"
 #include "mesher/boundary_fit.h"
 #include "mesher/ct_surface.h"
 #include "mesher/grid_mesher.h"
@@ -111,16 +112,23 @@ void info_volume_fit(const BoundaryFitReport& fit, const MeshFidelity& fidelity)
 }
 
 // `method: grid`. A mesh that stays inverted cannot be solved on.
-HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity) {
+HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity, std::string* core) {
   GridMeshOptions options;
   options.target_hexes = s.mesh.target_hexes;
   options.fit_volume = s.mesh.fit_volume;
   options.arch_frame = s.mesh.arch_frame;
-  options.swept_core = s.mesh.swept_core;
+  options.swept_core = s.mesh.core == MeshCore::kSwept;
   GridMeshReport report;
   HexMesh mesh;
   try {
-    mesh = grid_mesh(geometry.surface, options, &report);
+    if (s.mesh.core == MeshCore::kAuto) {
+      AutoCoreChoice choice;
+      mesh = grid_mesh_auto_core(geometry.surface, options, &report, &choice);
+      info(std::string("mesh.core auto: the ") + (choice.swept ? "swept" : "grid") + " core" +
+           (choice.reason.empty() ? "" : " (" + choice.reason + ")"));
+    } else {
+      mesh = grid_mesh(geometry.surface, options, &report);
+    }
   } catch (const NotAnArchError& e) {
     // A bone that follows no arch is the fault of the scenario's grid_frame, or of its swept core (other
     // input errors are not).
@@ -131,6 +139,7 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
+  *core = report.swept ? "swept" : "grid";
   // The first ten; results.json lists every one (mesh.fidelity.unresolved).
   for (const std::string& line : unresolved_listing(report.fidelity.unresolved))
     info("not resolved: " + line);
@@ -138,9 +147,9 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
     throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
                    "; try another target" +
-                   (s.mesh.swept_core   ? " or core: grid"
-                    : s.mesh.arch_frame ? " or grid_frame: axes"
-                                        : "") +
+                   (s.mesh.core == MeshCore::kSwept ? " or core: grid"
+                    : s.mesh.arch_frame             ? " or grid_frame: axes"
+                                                    : "") +
                    " (hexbite mesh shows where)");
   return mesh;
 }
@@ -610,7 +619,7 @@ RunResult run_pipeline(Scenario scenario, int levels) {
     const auto t = std::chrono::steady_clock::now();
     coarse = scenario.mesh.method == MeshMethod::kSheets
                  ? mesh_by_sheets(scenario, geometry, &result.fidelity)
-                 : mesh_by_grid(scenario, geometry, &result.fidelity);
+                 : mesh_by_grid(scenario, geometry, &result.fidelity, &result.mesh_core);
     seconds_mesh = seconds_since(t);
     progress.finish(std::to_string(coarse.hexes.size()) + " hexes");
   }

@@ -47,6 +47,8 @@ struct LevelResult {
 struct RunResult {
   Scenario scenario;      // with every point resolved
   MeshFidelity fidelity;  // of the coarse mesh against the bone surface
+  std::string
+      mesh_core;  // method grid: the core the coarse mesh has, "grid" or "swept" (mesh.core auto picks)
   std::vector<LevelResult> levels;
   double seconds_geometry = 0.0;
   double seconds_total = 0.0;

@@ -459,17 +459,18 @@ MeshSettings parse_mesh(const Value& v) {
            "grid_frame or write method: grid");
   }
   if (auto x = map.find("core")) {
-    m.swept_core = to_choice<bool>(*x, {{"grid", false}, {"swept", true}});
+    m.core = to_choice<MeshCore>(
+        *x, {{"grid", MeshCore::kGrid}, {"swept", MeshCore::kSwept}, {"auto", MeshCore::kAuto}});
     m.core_at = x->at;
     if (m.method != MeshMethod::kGrid)
       fail(x->at,
            "mesh.core chooses the core of method grid, but mesh.method is sheets; remove core or write "
            "method: grid");
-    if (m.swept_core && m.grid_frame_at.line > 0 && !m.arch_frame)
+    if (m.core == MeshCore::kSwept && m.grid_frame_at.line > 0 && !m.arch_frame)
       fail(x->at,
            "mesh.core swept sweeps the core across the dental arch, but mesh.grid_frame is axes; write "
            "grid_frame: arch, leave it out, or write core: grid");
-    if (m.swept_core) m.arch_frame = true;
+    if (m.core == MeshCore::kSwept) m.arch_frame = true;
   }
   return m;
 }

@@ -61,6 +61,7 @@ struct LandmarkSpec {
 };
 
 enum class MeshMethod { kGrid, kSheets };
+enum class MeshCore { kGrid, kSwept, kAuto };
 
 struct MeshSettings {
   MeshMethod method = MeshMethod::kGrid;
@@ -80,9 +81,10 @@ struct MeshSettings {
   // method grid only: lay the overlay grid along the dental arch (GridMeshOptions::arch_frame).
   bool arch_frame = false;
   SourceLocation grid_frame_at;  // where grid_frame was written
-  // method grid only: the core swept across the dental arch (GridMeshOptions::swept_core); implies the
-  // arch frame.
-  bool swept_core = false;
+  // method grid only: the core, grid, swept (across the dental arch, GridMeshOptions::swept_core; implies
+  // the arch frame) or auto (mesher/auto_core.h: the swept core for coarse meshes of a mandible, else the
+  // grid core in grid_frame).
+  MeshCore core = MeshCore::kGrid;
   SourceLocation core_at;  // where core was written
 };
 

@@ -296,14 +296,17 @@ TEST(Scenario, GridFrameIsReadForTheGridMethodOnly) {
                   "mesh.grid_frame lays the overlay grid of method grid, but mesh.method is sheets");
 }
 
-// mesh.core (grid or swept) is read for the grid method only; swept implies the arch frame and contradicts
-// an explicit grid_frame: axes.
+// mesh.core (grid, swept or auto) is read for the grid method only; swept implies the arch frame and
+// contradicts an explicit grid_frame: axes; auto leaves the grid core's frame to grid_frame.
 TEST(Scenario, SweptCoreIsReadForTheGridMethodAndImpliesTheArchFrame) {
-  EXPECT_FALSE(load_scenario(write_scenario(kValid)).mesh.swept_core);
+  EXPECT_EQ(load_scenario(write_scenario(kValid)).mesh.core, MeshCore::kGrid);
   const Scenario swept = load_scenario(write_scenario(kValid + "mesh: {core: swept}\n"));
-  EXPECT_TRUE(swept.mesh.swept_core);
+  EXPECT_EQ(swept.mesh.core, MeshCore::kSwept);
   EXPECT_TRUE(swept.mesh.arch_frame);
-  EXPECT_FALSE(load_scenario(write_scenario(kValid + "mesh: {core: grid}\n")).mesh.swept_core);
+  EXPECT_EQ(load_scenario(write_scenario(kValid + "mesh: {core: grid}\n")).mesh.core, MeshCore::kGrid);
+  const Scenario automatic = load_scenario(write_scenario(kValid + "mesh: {core: auto, grid_frame: axes}\n"));
+  EXPECT_EQ(automatic.mesh.core, MeshCore::kAuto);
+  EXPECT_FALSE(automatic.mesh.arch_frame);
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {core: octree}\n"), 11, "'octree'");
   EXPECT_ERROR_AT(error_of(kValid + "mesh:\n  method: sheets\n  core: swept\n"), 13,
                   "mesh.core chooses the core of method grid, but mesh.method is sheets");

@@ -1,0 +1,79 @@
+#include "mesher/auto_core.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+#include "mesher/arch_frame.h"
+
+namespace hexbite {
+
+namespace {
+
+std::string format(const char* pattern, double a, double b = 0) {
+  char text[160];
+  std::snprintf(text, sizeof text, pattern, a, b);
+  return text;
+}
+
+double worst_measure(const QualitySummary& q) {
+  return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
+}
+
+// What keeps a swept mesh from the bounds, or empty.
+std::string shortfall(const QualitySummary& q, const AutoCoreOptions& bounds) {
+  if (q.inverted > 0) return std::to_string(q.inverted) + " inverted hexes";
+  if (q.scaled_jacobian.min < bounds.min_scaled_jacobian)
+    return format("a scaled Jacobian of %.3f (below %.2f)", q.scaled_jacobian.min,
+                  bounds.min_scaled_jacobian);
+  if (q.condition.max > bounds.max_condition)
+    return format("a condition number of %.2f (above %.3g)", q.condition.max, bounds.max_condition);
+  return "";
+}
+
+}  // namespace
+
+HexMesh grid_mesh_auto_core(const TriSurface& surface, GridMeshOptions options, GridMeshReport* report,
+                            AutoCoreChoice* choice, const AutoCoreOptions& bounds) {
+  const bool grid_arch_frame = options.arch_frame;
+  auto grid_core = [&](std::string reason) {
+    options.swept_core = false;
+    options.arch_frame = grid_arch_frame;
+    *choice = {false, std::move(reason)};
+    return grid_mesh(surface, options, report);
+  };
+  if (options.target_hexes > bounds.swept_up_to_hexes)
+    return grid_core(std::to_string(options.target_hexes) + " target hexes: the swept core is for up to " +
+                     std::to_string(bounds.swept_up_to_hexes));
+
+  GridMeshOptions swept_options = options;
+  swept_options.swept_core = true;
+  swept_options.arch_frame = true;
+  GridMeshReport swept_report;
+  HexMesh swept;
+  try {
+    swept = grid_mesh(surface, swept_options, &swept_report);
+  } catch (const NotAnArchError&) {
+    return grid_core("the surface follows no dental arch");
+  }
+  const QualitySummary& s = swept_report.optimize.phases.back().quality;
+  const std::string missed = shortfall(s, bounds);
+  if (missed.empty()) {
+    *report = std::move(swept_report);
+    *choice = {true, ""};
+    return swept;
+  }
+  HexMesh grid = grid_core("");
+  const QualitySummary& g = report->optimize.phases.back().quality;
+  const bool grid_better =
+      g.inverted != s.inverted ? g.inverted < s.inverted : worst_measure(g) > worst_measure(s);
+  if (grid_better) {
+    *choice = {false, "the swept core left " + missed + "; the grid core did better"};
+    return grid;
+  }
+  *report = std::move(swept_report);
+  *choice = {true, "the swept core left " + missed + ", the grid core no better"};
+  return swept;
+}
+
+}  // namespace hexbite
