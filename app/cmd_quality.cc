@@ -1,18 +1,22 @@
-// hexbite quality MESH.vtu [--json]: the quality table of a hex mesh, laid out like the seed paper's Table 1.
-// A Gmsh .msh file is accepted as well.
+// hexbite quality MESH.vtu [--json] [--worst N]: the quality table of a hex mesh, laid out like the seed
+// paper's Table 1, and optionally its N worst hexes with where they are. A Gmsh .msh file is accepted as
+// well.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
+#include "mesher/hex_quality_worst.h"
 #include "postprocess/quality_json.h"
 
 namespace hexbite {
@@ -22,6 +26,7 @@ namespace {
 struct QualityOptions {
   std::string mesh;
   bool json = false;
+  long worst = 0;
 };
 
 // Fixed-point for the usual range; scientific once a value would no longer fit the column.
@@ -82,6 +87,35 @@ std::string quality_table(const std::string& path, const QualitySummary& s) {
   return out.str();
 }
 
+// The worst hexes as a small table after the report.
+std::string worst_table(const std::vector<WorstHex>& worst) {
+  std::ostringstream out;
+  out << "\nworst " << worst.size() << (worst.size() == 1 ? " hex" : " hexes")
+      << " (lowest scaled Jacobian first; ties: larger condition number first):\n";
+  char line[192];
+  std::snprintf(line, sizeof line, "%10s%18s%18s   %s\n", "hex", "scaled Jacobian", "condition",
+                "centroid (mm)");
+  out << line;
+  for (const WorstHex& w : worst) {
+    std::snprintf(line, sizeof line, "%10d%18s%18s   (%.2f, %.2f, %.2f)\n", w.hex,
+                  cell(w.scaled_jacobian).c_str(), cell(w.condition).c_str(), w.centroid[0], w.centroid[1],
+                  w.centroid[2]);
+    out << line;
+  }
+  out << "(hex: 0-based index; condition number k = |A|_F |A^-1|_F, cube = 3, inf for an inverted hex)\n";
+  return out.str();
+}
+
+nlohmann::json worst_json(const std::vector<WorstHex>& worst) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const WorstHex& w : worst)
+    list.push_back({{"hex", w.hex},
+                    {"scaled_jacobian", w.scaled_jacobian},
+                    {"condition", w.condition},
+                    {"centroid", {w.centroid[0], w.centroid[1], w.centroid[2]}}});
+  return list;
+}
+
 }  // namespace
 
 void add_quality_command(CLI::App& app) {
@@ -91,16 +125,30 @@ void add_quality_command(CLI::App& app) {
       "Print the quality of a hex mesh (scaled Jacobian, condition number, Oddy, inverted elements)");
   cmd->add_option("mesh", options->mesh, "Hex mesh file (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
   cmd->add_flag("--json", options->json, "Print one JSON object instead of the table");
-  cmd->callback([options] {
+  CLI::Option* worst_option =
+      cmd->add_option(
+             "--worst", options->worst,
+             "Also list the N hexes of lowest scaled Jacobian (ties: larger condition number first) with "
+             "their index, condition number and centroid (JSON key \"worst\")")
+          ->transform(count_in_range(0, 2147483647))
+          ->default_val(0);
+  cmd->callback([options, worst_option] {
+    const bool list_worst = worst_option->count() > 0;
     // Gmsh meshes are read too, so that peer meshers can be measured with exactly the same code.
     const std::string ext = std::filesystem::path(options->mesh).extension().string();
     const HexMesh mesh = (ext == ".msh" || ext == ".MSH") ? read_msh(options->mesh) : read_vtu(options->mesh);
-    const QualitySummary summary = summarize_quality(mesh);
-    if (options->json)
+    const HexQualityField field = compute_hex_quality(mesh);
+    const QualitySummary summary = summarize_quality(mesh, field);
+    const std::vector<WorstHex> worst = worst_hexes(mesh, field, static_cast<std::size_t>(options->worst));
+    if (options->json) {
       // The volume lets benchmarks compare a mesh with its surface (and peers' meshes with ours).
-      std::cout << quality_to_json(summary, hex_mesh_volume(mesh)).dump(2) << '\n';
-    else
+      nlohmann::json j = quality_to_json(summary, hex_mesh_volume(mesh));
+      if (list_worst) j["worst"] = worst_json(worst);
+      std::cout << j.dump(2) << '\n';
+    } else {
       std::cout << quality_table(options->mesh, summary);
+      if (!worst.empty()) std::cout << worst_table(worst);
+    }
   });
 }
 

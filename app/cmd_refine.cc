@@ -4,8 +4,9 @@
 // Splits every hex into 8 (every boundary quad into 4), puts the new boundary nodes onto the surface when one
 // is given and re-optimizes where that made the quality worse; prints the quality before and after each step
 // and the timings. The coarse nodes keep their numbers and positions, so coarse and fine results can be
-// compared node by node. A refined mesh with inverted hexes is a failed run (exit 1, naming them with their
-// centroids) and is not written.
+// compared node by node. An input mesh with inverted hexes is refused up front (exit 2, naming them with
+// their centroids); a refined mesh with inverted hexes is a failed run (exit 1, naming them likewise).
+// Neither is written.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
@@ -186,6 +187,23 @@ void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surf
   throw InputError(text.str());
 }
 
+// Every child of an inverted hex is inverted too, so refining an inverted mesh can only fail at the end; it
+// is refused up front as bad input, naming the hexes and where they are.
+void require_no_inverted_hexes(const HexMesh& coarse, const RefineCliOptions& o) {
+  const HexQualityField field = compute_hex_quality(coarse);
+  std::vector<int> inverted;
+  for (std::size_t h = 0; h < coarse.hexes.size(); ++h)
+    if (!(field.jacobian[h] > 0.0)) inverted.push_back(static_cast<int>(h));  // NaN counts as inverted
+  if (inverted.empty()) return;
+  const std::string count = std::to_string(inverted.size());
+  throw InputError(
+      "'" + o.mesh + "' has " + count + " inverted " + (inverted.size() == 1 ? "hex" : "hexes") +
+      " (a corner Jacobian <= 0), which refinement cannot repair: " + hex_list_text(coarse, inverted, 5) +
+      "; nothing written: re-mesh the surface (hexbite mesh), or find the worst hexes with "
+      "hexbite quality " +
+      o.mesh + " --worst " + count);
+}
+
 void run_refine(const RefineCliOptions& o) {
   if (o.fit_volume && o.surface.empty())
     throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
@@ -196,6 +214,7 @@ void run_refine(const RefineCliOptions& o) {
                      std::to_string(coarse.hexes.size()) + " hexes of " + o.mesh + " into " +
                      std::to_string(refined) + " hexes, more than " + std::to_string(kMaxRefinedHexes) +
                      "; use fewer levels");
+  require_no_inverted_hexes(coarse, o);
   std::unique_ptr<SurfaceProjector> projector;
   if (!o.surface.empty()) {
     projector = std::make_unique<SurfaceProjector>(load_surface_input(o.surface, o.units));
@@ -215,12 +234,8 @@ void run_refine(const RefineCliOptions& o) {
   else if (!is_quiet())
     std::cout << report_text(o, report);
   if (!valid) {
-    std::string cause;
-    if (report.before.inverted > 0)
-      cause = " (the input already has " + std::to_string(report.before.inverted) +
-              " inverted hexes: check it with hexbite quality)";
     throw RunError(
-        std::to_string(report.after.inverted) + " hexes of the refined mesh are inverted" + cause + ": " +
+        std::to_string(report.after.inverted) + " hexes of the refined mesh are inverted: " +
         hex_list_text(fine, report.after.inverted_hexes, 20,
                       [&o](int h) { return " (in input hex " + std::to_string(h >> (3 * o.levels)) + ")"; }) +
         "; no mesh written");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -237,6 +238,24 @@ double positive(const Value& v, const std::string& unit_hint) {
     fail(v.at, v.path + " is " + fmt(x) + " but must be positive" + (x < 0 ? " (it is negative)" : "") +
                    "; give " + unit_hint);
   return x;
+}
+
+// The largest radius of a muscle insertion or support patch. A patch is a muscle's insertion area or a
+// contact (a tooth, a condyle), at most a few centimetres across (the largest, the masseter's insertion on
+// the ramus, spans about 3 to 4 cm); the whole mandible is about 100 mm across, so a 50 mm patch already
+// covers most of one side. Larger radii (1000 mm ran and loaded or held the whole bone) are a slip of the
+// unit or the digits.
+constexpr double kMaxPatchRadiusMm = 50.0;
+
+double patch_radius(const Value& v, const std::string& unit_hint) {
+  const double r = positive(v, unit_hint);
+  if (r > kMaxPatchRadiusMm)
+    fail(v.at,
+         v.path + " is " + fmt(r) + " mm but must be greater than 0 and at most " + fmt(kMaxPatchRadiusMm) +
+             " mm: a patch is an insertion or contact area, and a mandible is about 100 mm across, so " +
+             fmt(r) + " mm would take in most or all of the bone; give " + unit_hint +
+             ", and check that the value is not in another unit");
+  return r;
 }
 
 // A mapping whose keys are checked against the valid ones on construction (unknown and repeated keys
@@ -573,7 +592,8 @@ Muscle parse_muscle(const Value& item) {
   const Map map(item, {"name", "insertion", "radius_mm", "origin", "direction", "max_force_N", "activation"});
   Muscle m = default_muscle(to_string(map.require("name", "name: right_superficial_masseter")), item.at);
   if (auto x = map.find("insertion")) m.insertion = to_point(*x);
-  if (auto x = map.find("radius_mm")) m.radius_mm = positive(*x, "the insertion patch radius in mm, e.g. 10");
+  if (auto x = map.find("radius_mm"))
+    m.radius_mm = patch_radius(*x, "the insertion patch radius in mm, e.g. 10");
   if (map.has("origin") && map.has("direction"))
     fail(map.key_at("direction"),
          "muscle " + quote(m.name) +
@@ -643,7 +663,8 @@ Support parse_support(const Value& item) {
   s.where = item.at;
   s.name = to_string(map.require("name", "name: right_condyle"));
   s.at = to_point(map.require("at", "at: right_condyle_tmj_point"));
-  s.radius_mm = positive(map.require("radius_mm", "radius_mm: 5"), "the support patch radius in mm, e.g. 5");
+  s.radius_mm =
+      patch_radius(map.require("radius_mm", "radius_mm: 5"), "the support patch radius in mm, e.g. 5");
   if (map.has("fixed") && map.has("spring_N_per_mm3"))
     fail(map.key_at("spring_N_per_mm3"),
          "support " + quote(s.name) +
@@ -830,6 +851,64 @@ Vec3 quad_centroid(const QuadSurface& surface, const std::array<int, 4>& quad) {
   return c;
 }
 
+// Where the innermost '[' or '{' that is still open at yaml-cpp's mark was opened, or nothing. yaml-cpp
+// reports an unclosed flow collection ("end of sequence flow not found") at the token that should have been
+// ',' or ']', usually on a later line; the user needs the line of the bracket. The scan skips comments and
+// quoted text, and takes a bracket outside any flow collection as an opener only where a value can begin
+// (at the start of a line or after ': ', '- ', '? '), so that '[' inside plain text ("note: see [1") is not
+// counted. Block scalars ('|', '>') are not recognized: a bracket at the start of one of their lines would be
+// taken for an opener, which is why the caller checks the bracket's kind and still names yaml-cpp's place.
+std::optional<std::pair<SourceLocation, char>> unclosed_flow_opener(const std::string& text,
+                                                                    const YAML::Mark& mark,
+                                                                    const std::string& file) {
+  struct Open {
+    int line, column;
+    char bracket;
+  };
+  std::vector<Open> open;
+  int line = 0, column = 0;
+  char quote = 0;     // the quote of the quoted scalar we are in, or 0
+  char previous = 0;  // the last character on this line that is not a space (0: none yet)
+  bool space = true;  // the character before is a space, a tab or the start of the line
+  // A quoted scalar or a flow collection may begin here: at the start of a line, after ': ', '- ' or '? '
+  // outside flow collections, and after '[', '{', ',', ':' or '?' inside one.
+  const auto value_can_begin = [&] {
+    if (previous == 0) return true;
+    if (open.empty()) return space && std::strchr(":-?", previous) != nullptr;
+    return std::strchr("[{,:?", previous) != nullptr;
+  };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (line > mark.line || (line == mark.line && column >= mark.column)) break;
+    const char c = text[i];
+    if (c == '\n') {
+      ++line, column = 0, previous = 0, space = true;
+      continue;
+    }
+    if (quote == '"' && c == '\\') {  // an escape: skip the escaped character (not a newline)
+      if (i + 1 < text.size() && text[i + 1] != '\n') ++i, ++column;
+    } else if (quote == '\'' && c == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
+      ++i, ++column;  // '' is a quote inside single quotes
+    } else if (quote != 0) {
+      if (c == quote) quote = 0;
+    } else if (c == '#' && space) {
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+      continue;  // the newline resets the line's state
+    } else if ((c == '"' || c == '\'') && value_can_begin()) {
+      quote = c;
+    } else if ((c == '[' || c == '{') && (!open.empty() || value_can_begin())) {
+      open.push_back({line, column, c});
+    } else if ((c == ']' || c == '}') && !open.empty() && open.back().bracket == (c == ']' ? '[' : '{')) {
+      open.pop_back();
+    }
+    if (c != ' ' && c != '\t') previous = c;
+    space = c == ' ' || c == '\t';
+    ++column;
+  }
+  if (open.empty()) return std::nullopt;
+  return std::make_pair(SourceLocation{file, open.back().line + 1, open.back().column + 1},
+                        open.back().bracket);
+}
+
 }  // namespace
 
 Scenario load_scenario(const std::string& path) {
@@ -843,6 +922,15 @@ Scenario load_scenario(const std::string& path) {
     documents = YAML::LoadAll(text.str());
   } catch (const YAML::Exception& e) {
     const SourceLocation where{path, e.mark.line + 1, e.mark.column + 1};
+    // An unclosed '[' or '{': named where it opened, not where yaml-cpp noticed (often a later line).
+    const bool sequence = e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW;
+    if (sequence || e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW)
+      if (const auto opener = unclosed_flow_opener(text.str(), e.mark, path);
+          opener && opener->second == (sequence ? '[' : '{'))
+        fail(opener->first, std::string("YAML syntax error: this '") + opener->second + "' is not closed (" +
+                                e.msg + ", noticed at line " + std::to_string(where.line) + ", column " +
+                                std::to_string(where.column) + "); add the '" + (sequence ? ']' : '}') +
+                                "' that closes it, and check the commas between its entries");
     fail(where,
          "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets near this place");
   }

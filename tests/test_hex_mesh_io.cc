@@ -428,6 +428,48 @@ TEST(QualityCommand, JsonMatchesLibrary) {
     EXPECT_NE(table.out.find(row), std::string::npos) << row << "\n" << table.out;
 }
 
+// --worst N lists the N hexes of lowest scaled Jacobian with their condition numbers and centroids, as a
+// table after the report and as "worst" in --json; without it the output is what it was.
+TEST(QualityCommand, WorstHexesInTextAndJson) {
+  HexMesh mesh = make_block_mesh(3, 3, 3);
+  mesh.vertices[mesh.hexes[0][6]] = {0.5, 0.5, 0.5};  // hex 0 inverted, the neighbours of the vertex bent
+  const std::string path = temp_dir() + "/w.vtu";
+  write_vtu(path, mesh);
+
+  test::CommandResult r = run_hexbite({"quality", path, "--json", "--worst", "3"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("worst")) << r.out;
+  ASSERT_EQ(j["worst"].size(), 3u);
+  EXPECT_EQ(j["worst"][0]["hex"], 0);
+  EXPECT_NEAR(j["worst"][0]["scaled_jacobian"].get<double>(), -0.7698, 1e-4);
+  EXPECT_TRUE(j["worst"][0]["condition"].is_null());  // +inf: inverted
+  EXPECT_EQ(j["worst"][0]["centroid"].size(), 3u);
+  const Vec3 c = hex_centroid(mesh, 0);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(j["worst"][0]["centroid"][a].get<double>(), c[a], 1e-12);
+  EXPECT_TRUE(j["worst"][1]["condition"].is_number());
+  EXPECT_LE(j["worst"][1]["scaled_jacobian"].get<double>(), j["worst"][2]["scaled_jacobian"].get<double>());
+  // The other keys are those without --worst.
+  nlohmann::json plain = nlohmann::json::parse(run_hexbite({"quality", path, "--json"}).out);
+  EXPECT_FALSE(plain.contains("worst"));
+  j.erase("worst");
+  EXPECT_EQ(j, plain);
+
+  r = run_hexbite({"quality", path, "--worst", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("worst 2 hexes (lowest scaled Jacobian first; ties: larger condition number first):\n"
+                       "       hex   scaled Jacobian         condition   centroid (mm)\n"
+                       "         0           -0.7698               inf   (0.44, 0.44, 0.44)\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.rfind(run_hexbite({"quality", path}).out, 0), 0u) << "the report before the list changed";
+
+  // A count is a whole number from 0.
+  r = run_hexbite({"quality", path, "--worst", "-1"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("give a whole number from 0"), std::string::npos) << r.err;
+}
+
 TEST(QualityCommand, JsonVolumeOfVtuAndMsh) {
   // A 2 x 3 x 4 block of unit cubes, sheared (x += 0.5 z): the volume stays 24, the hexes are not boxes.
   HexMesh mesh = make_block_mesh(2, 3, 4);

@@ -11,6 +11,7 @@
 
 #include "mesher/hex_block.h"
 #include "mesher/hex_quality.h"
+#include "mesher/hex_quality_worst.h"
 
 namespace hexbite {
 namespace {
@@ -237,6 +238,46 @@ TEST(HexQuality, SummaryOfABlock) {
   for (int c : s.scaled_jacobian_histogram.counts) total += c;
   EXPECT_EQ(total, 27);
   EXPECT_EQ(s.condition_histogram.above, s.inverted);  // +inf lands above the range
+}
+
+// hexbite quality --worst N: lowest scaled Jacobian first, ties by the larger condition number, then index.
+TEST(HexQuality, WorstHexesAreOrderedBySJThenCondition) {
+  HexMesh mesh = make_block_mesh(3, 3, 3);
+  mesh.vertices[mesh.hexes[0][6]] = {0.5, 0.5, 0.5};  // hex 0 inverted (the fixture), its 7 neighbours bent
+  const HexQualityField field = compute_hex_quality(mesh);
+  const std::vector<WorstHex> worst = worst_hexes(mesh, field, 5);
+  ASSERT_EQ(worst.size(), 5u);
+  EXPECT_EQ(worst[0].hex, 0);
+  EXPECT_NEAR(worst[0].scaled_jacobian, -4.0 / (3.0 * std::sqrt(3.0)), 1e-12);
+  EXPECT_TRUE(std::isinf(worst[0].condition));
+  for (std::size_t i = 0; i < worst.size(); ++i) {
+    const int h = worst[i].hex;
+    EXPECT_EQ(worst[i].scaled_jacobian, field.scaled_jacobian[h]);
+    EXPECT_EQ(worst[i].condition, field.condition[h]);
+    const Vec3 c = hex_centroid(mesh, h);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(worst[i].centroid[a], c[a]);
+    if (i > 0) EXPECT_LE(worst[i - 1].scaled_jacobian, worst[i].scaled_jacobian);
+  }
+  // No hex outside the list is worse than the last one listed.
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    bool listed = false;
+    for (const WorstHex& w : worst) listed |= w.hex == static_cast<int>(h);
+    if (!listed) EXPECT_GE(field.scaled_jacobian[h], worst.back().scaled_jacobian) << h;
+  }
+  EXPECT_TRUE(worst_hexes(mesh, field, 0).empty());
+  EXPECT_EQ(worst_hexes(mesh, field, 1000).size(), 27u);
+
+  // Equal scaled Jacobians (boxes are all 1): the more stretched box first, then the lower index.
+  HexMesh row = make_block_mesh(3, 1, 1);
+  for (Vec3& p : row.vertices)
+    if (p[0] > 2.5) p[0] += 2.0;  // hex 2 becomes a 3 x 1 x 1 box
+  const std::vector<WorstHex> ties = worst_hexes(row, compute_hex_quality(row), 3);
+  ASSERT_EQ(ties.size(), 3u);
+  EXPECT_EQ(ties[0].hex, 2);
+  EXPECT_GT(ties[0].condition, 3.0 + 1e-9);
+  EXPECT_EQ(ties[1].hex, 0);
+  EXPECT_EQ(ties[2].hex, 1);
+  EXPECT_EQ(ties[0].scaled_jacobian, ties[1].scaled_jacobian);
 }
 
 TEST(HexQuality, HistogramEdges) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -276,15 +277,32 @@ TEST(HexRefineCommand, BadInput) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out.vtu"));
 
-  // A mesh whose refinement is inverted: a failed run that names the hexes and where they are.
+  // An input mesh that is already inverted: every child of an inverted hex is inverted, so it used to refine
+  // everything and then fail (exit 1). It is bad input, refused before any work (exit 2), with the file, the
+  // count, the hexes and where they are, and what to do; with or without a surface.
   HexMesh bad = block(2, 1, 1);
   bad.vertices[bad.hexes[1][6]] = {0.2, 0.2, 0.2};
   write_vtu(dir + "/bad.vtu", bad);
-  r = run_hexbite({"refine", dir + "/bad.vtu", "-o", dir + "/out.vtu"});
-  EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("inverted"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find(" at ("), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(dir + "/out.vtu"));
+  const Vec3 c = hex_centroid(bad, 1);
+  char at[96];
+  std::snprintf(at, sizeof at, "hex 1 at (%.2f, %.2f, %.2f) mm", c[0], c[1], c[2]);
+  for (const bool with_surface : {false, true}) {
+    std::vector<std::string> args = {"refine", dir + "/bad.vtu", "-o", dir + "/out.vtu"};
+    if (with_surface) args.insert(args.end(), {"--surface", dir + "/open.stl"});  // not even read
+    r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("hexbite: error: '" + dir +
+                         "/bad.vtu' has 1 inverted hex (a corner Jacobian <= 0), "
+                         "which refinement cannot repair: " +
+                         at +
+                         "; nothing written: re-mesh the surface "
+                         "(hexbite mesh), or find the worst hexes with hexbite quality " +
+                         dir + "/bad.vtu --worst 1"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_FALSE(fs::exists(dir + "/out.vtu"));
+  }
 }
 
 }  // namespace

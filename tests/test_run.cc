@@ -826,10 +826,11 @@ TEST(RunScenario, SolverOutOfIterationsNamesTheScenariosSettings) {
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
-// One fixed support over the whole bone: zero displacement and the muscles' total as the bite force, exit 0.
+// One fixed support over a muscle's whole insertion (it was a 1000 mm support over the whole bone, before
+// patch radii were limited to 50 mm): the muscle's force went straight into the reaction, exit 0.
 TEST(RunScenario, MuscleWhollyOnFixedNodesIsRefused) {
   std::string text = kSmall.substr(0, kSmall.find("supports:"));
-  text += "supports:\n  - {name: all, at: incisal_point, radius_mm: 1000, bite: true}\n";
+  text += "supports:\n  - {name: all, at: left_superficial_masseter.insertion, radius_mm: 30, bite: true}\n";
   const std::string err =
       expect_refused(text, "the insertion patch of muscle 'left_superficial_masseter' lies wholly on nodes");
   EXPECT_NE(err.find("bad.yaml:6:"), std::string::npos) << err;  // the activation_pattern entry

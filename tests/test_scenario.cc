@@ -427,6 +427,22 @@ TEST(ScenarioErrors, NegativeRadiusOrForce) {
                   "supports[0].radius_mm is -4");
 }
 
+// A support of 1000 mm ran: it held the whole bone (and a muscle patch that large loaded all of it). Patch
+// radii are at most 50 mm; the message names the line, the key, the value, the range and what to do.
+TEST(ScenarioErrors, AbsurdPatchRadius) {
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "radius_mm: 4", "radius_mm: 1000")), 8,
+      "supports[0].radius_mm is 1000 mm but must be greater than 0 and at most 50 mm: a patch is an "
+      "insertion "
+      "or contact area, and a mandible is about 100 mm across, so 1000 mm would take in most or all of the "
+      "bone; give the support patch radius in mm, e.g. 5, and check that the value is not in another unit");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    radius_mm: 50.5")), 7,
+      "muscles[0].radius_mm is 50.5 mm but must be greater than 0 and at most 50 mm");
+  // The bound itself is allowed.
+  EXPECT_NO_THROW(load_scenario(write_scenario(replace(kValid, "radius_mm: 4", "radius_mm: 50"))));
+}
+
 TEST(ScenarioErrors, ImplausibleForceTargetOrCoordinates) {
   // 1e30 N gave absurd figures with exit 0 and 1e300 N a "not finite" failure blaming the supports.
   EXPECT_ERROR_AT(
@@ -534,8 +550,39 @@ TEST(ScenarioErrors, GeometryNeedsExactlyOneSource) {
   }
 }
 
+// An unclosed '[' or '{' was reported where yaml-cpp noticed it, the line after (or several lines later);
+// now at the bracket itself, with where the parser noticed it. Brackets in comments, quoted text and plain
+// text do not count.
+TEST(ScenarioErrors, UnclosedBracketIsReportedWhereItOpens) {
+  const std::string message = error_of("name: t\ngeometry: {mandible: [1, 2\n");
+  EXPECT_NE(
+      message.find("/bad.yaml:2:22: YAML syntax error: this '[' is not closed (end of sequence flow not "
+                   "found, noticed at line 3, column 1); add the ']' that closes it, and check the commas "
+                   "between its entries"),
+      std::string::npos)
+      << message;
+  const std::string text =
+      "name: t\n"
+      "description: see [1 # and [2\n"
+      "geometry: {mandible: {variant: \"a [b\"}}  # [c\n"
+      "supports:\n"
+      "  - {name: nut, at: [1, 2, 3, radius_mm: 4, bite: true\n"
+      "  - {name: b, at: x, radius_mm: 4}\n"
+      "probes: []\n";
+  EXPECT_ERROR_AT(error_of(text), 5,
+                  "this '[' is not closed (end of sequence flow not found, noticed at line 6");
+  EXPECT_NE(error_of(text).find("bad.yaml:5:21:"), std::string::npos) << error_of(text);
+  EXPECT_ERROR_AT(error_of("name: t\nsupports: [{name: a}, {name: 'it''s [', at: x\n"), 2,
+                  "this '{' is not closed (end of map flow not found, noticed at line 3");
+  EXPECT_NE(error_of("name: t\nsupports: [{name: a}, {name: 'it''s [', at: x\n").find("bad.yaml:2:23:"),
+            std::string::npos);
+  // Other syntax errors keep yaml-cpp's place.
+  EXPECT_ERROR_AT(error_of("name: t\nsupports:\n  - {name: nut, at: [1, 2, 3, radius_mm: 4}\n"), 3,
+                  "YAML syntax error: illegal flow end");
+}
+
 TEST(ScenarioErrors, YamlSyntaxAndEmptyFiles) {
-  EXPECT_ERROR_AT(error_of("name: t\ngeometry: {mandible: [1, 2\n"), 3, "YAML syntax error");
+  EXPECT_ERROR_AT(error_of("name: t\ngeometry: {mandible: [1, 2\n"), 2, "YAML syntax error");
   EXPECT_ERROR_AT(error_of(""), 1, "the scenario file is empty");
   EXPECT_THROW(load_scenario("/nonexistent/scenario.yaml"), InputError);
 }
