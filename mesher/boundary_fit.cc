@@ -175,6 +175,10 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
   if (local.inverted && options.keep_worst) return report;  // only valid meshes keep their worst
   auto& [hexes_of, quality, sj_min, kappa_max, inverted] = local;
   const std::vector<Vec3>& samples = surface.surface().vertices;
+  const double sj_bound =
+      options.floor_scaled_jacobian > 0 ? std::min(sj_min, options.floor_scaled_jacobian) : sj_min;
+  const double kappa_bound = std::max(kappa_max, options.max_condition);
+  std::vector<char> ever_moved(mesh.vertices.size(), 0);
   for (int round = 0; round < options.rounds; ++round) {
     const HexBoundary boundary = extract_boundary(mesh);
     const QuadSurface& q = boundary.surface;
@@ -214,8 +218,8 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
           const HexQuality h = quality_of(mesh, e);
           const bool pass =
               options.keep_worst
-                  ? !h.inverted && h.scaled_jacobian >= std::min(quality[e].scaled_jacobian, sj_min) &&
-                        h.condition <= std::max(quality[e].condition, kappa_max)
+                  ? !h.inverted && h.scaled_jacobian >= std::min(quality[e].scaled_jacobian, sj_bound) &&
+                        h.condition <= std::max(quality[e].condition, kappa_bound)
                   : h.scaled_jacobian >= std::min(quality[e].scaled_jacobian, options.min_scaled_jacobian);
           if (!pass) {
             accepted = false;
@@ -228,6 +232,8 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
         continue;
       }
       for (int e : hexes_of[node]) quality[e] = quality_of(mesh, e);
+      if (!ever_moved[node]) report.moved.push_back(node);
+      ever_moved[node] = 1;
       ++moved;
     }
     report.moved_nodes += moved;

@@ -64,8 +64,10 @@ BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& 
 // until the hexes around the node pass the rule, else dropped. With keep_worst the rule is the volume fit's:
 // every hex keeps its scaled Jacobian at least the smaller of its own and the mesh's minimum and its
 // condition number at most the larger of its own and the mesh's maximum (a mesh with an inverted hex is left
-// unchanged); without it (before the optimizer, which untangles and improves what the moves spoil) no hex
-// falls below the smaller of its own scaled Jacobian and min_scaled_jacobian.
+// unchanged), or, with floor_scaled_jacobian / max_condition, at least the smaller of its own and
+// min(mesh's minimum, floor) and at most the larger of its own and max(mesh's maximum, cap); without it
+// (before the optimizer, which untangles and improves what the moves spoil) no hex falls below the smaller
+// of its own scaled Jacobian and min_scaled_jacobian.
 // Cost: per round one closest-point query per surface vertex against the boundary, and a scan of the boundary
 // nodes per far vertex, O(V log Q + F B) for V surface vertices, Q quads, F far vertices, B boundary nodes.
 struct FarSurfaceOptions {
@@ -73,11 +75,16 @@ struct FarSurfaceOptions {
   int rounds = 5;      // rounds (stops early when no node moves)
   bool keep_worst = true;
   double min_scaled_jacobian = 0.05;  // without keep_worst
+  // With keep_worst: hexes may fall to min(mesh's minimum, this) and rise to max(mesh's maximum,
+  // max_condition), or stay where they are if already beyond (0: the mesh's worst, never worse).
+  double floor_scaled_jacobian = 0.0;
+  double max_condition = 0.0;
 };
 
 struct FarSurfaceReport {
-  int far_vertices = 0;  // surface vertices farther than the limit in the first round
-  int moved_nodes = 0;   // moves over all rounds
+  int far_vertices = 0;    // surface vertices farther than the limit in the first round
+  int moved_nodes = 0;     // moves over all rounds
+  std::vector<int> moved;  // the nodes that moved, each once
   double seconds = 0;
 };
 

@@ -143,21 +143,14 @@ TEST_F(LateralBite, EvaluatesEveryProbeInsideTheMesh) {
   }
 }
 
-// At 4,000 hexes the swept core (mesh.core auto) leaves the condyles' lateral poles off the mesh (the grid
-// core the coronoid tips, thinner than a cell); results.json names them by the built-in mandible's
-// landmarks, as `hexbite mesh --landmarks` does.
-TEST_F(LateralBite, NamesThePartsTheMeshDoesNotResolve) {
+// The shipped scenario's coarse mesh is the swept core (mesh.core auto), whose last tips pass reaches the
+// condyle poles at 4,000 hexes: no part of the bone is left off the mesh (measured 2026-11-23: Hausdorff
+// distance 1.11 mm; 1.90 mm with the condyle poles 1.4-1.9 mm off before that pass went down to its floor,
+// and the grid core's coronoid tips, RunScenario.NamesThePartsTheMeshDoesNotResolve).
+TEST_F(LateralBite, SweptCoreLeavesNoPartOfTheBoneOffTheMesh) {
   EXPECT_EQ((*results_)["mesh"]["core"], "swept");
-  const json& unresolved = (*results_)["mesh"]["fidelity"]["unresolved"];
-  ASSERT_FALSE(unresolved.empty());
-  bool condyle = false;
-  for (const json& part : unresolved) {
-    ASSERT_FALSE(part["near"].empty()) << part.dump();
-    for (const json& n : part["near"])
-      condyle |= n["name"].get<std::string>().find("condyle") != std::string::npos;
-    EXPECT_GT(part["extent_mm"].get<double>(), 0.0);
-  }
-  EXPECT_TRUE(condyle) << unresolved.dump();
+  EXPECT_TRUE((*results_)["mesh"]["fidelity"]["unresolved"].empty());
+  EXPECT_LT((*results_)["mesh"]["fidelity"]["hausdorff_mm"].get<double>(), 1.5);
 }
 
 TEST_F(LateralBite, WritesMeshAndSolutionFilesMatchingTheResults) {
@@ -526,6 +519,24 @@ json run_small_with(const std::string& mesh_keys) {
   text.replace(text.find("target_hexes"), 0, mesh_keys);
   test::write_file(dir + "/variant.yaml", text);
   return run_scenario(dir + "/variant.yaml", dir + "/variant");
+}
+
+// At 4,000 hexes the grid core (kSmall has no mesh.core) keeps the coronoid tips thinner than a cell off
+// the mesh; results.json names them by the built-in mandible's landmarks, as `hexbite mesh --landmarks`
+// does.
+TEST(RunScenario, NamesThePartsTheMeshDoesNotResolve) {
+  const json& r = small_run();
+  EXPECT_EQ(r["mesh"]["core"], "grid");
+  const json& unresolved = r["mesh"]["fidelity"]["unresolved"];
+  ASSERT_FALSE(unresolved.empty());
+  bool coronoid = false;
+  for (const json& part : unresolved) {
+    ASSERT_FALSE(part["near"].empty()) << part.dump();
+    for (const json& n : part["near"])
+      coronoid |= n["name"].get<std::string>().find("coronoid_tip") != std::string::npos;
+    EXPECT_GT(part["extent_mm"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(coronoid) << unresolved.dump();
 }
 
 // `mesh: {method: sheets}` on the built-in mandible (its own landmarks place the template): the sheet

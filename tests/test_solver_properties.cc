@@ -357,13 +357,16 @@ TEST(SolverResults, StrainEnergyEqualsWorkOfLoadsAndStressesAreConsistent) {
   EXPECT_LT(s.von_mises_max_at[0], 10.0);
   // The largest displacement is at the loaded end.
   EXPECT_NEAR(s.max_displacement_at[0], 100.0, 1e-12);
-  // A probe at a vertex reports that vertex's displacement; a probe outside the mesh is not found.
-  problem.probes = {{100.0, 5.0, 5.0}, {150.0, 5.0, 5.0}};
+  // A probe at a vertex reports that vertex's displacement, one 0.1 mm outside (2 % of its 5 mm hex) that of
+  // the nearest point of the hex (the same vertex here); a probe well outside the mesh is not found.
+  problem.probes = {{100.0, 5.0, 5.0}, {150.0, 5.0, 5.0}, {100.1, 5.0, 5.0}};
   const ElasticitySolution p = solve_elasticity(problem);
   const Vec3& tip = p.vertex_displacement[grid.vertex(20, 1, 1)];
   ASSERT_TRUE(p.probes[0].found);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(p.probes[0].displacement[c], tip[c], 1e-12);
   EXPECT_FALSE(p.probes[1].found);
+  ASSERT_TRUE(p.probes[2].found);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(p.probes[2].displacement[c], tip[c], 1e-12);
 }
 
 TEST(SolverInput, MalformedProblemsAreRejectedWithClearMessages) {

@@ -143,11 +143,12 @@ Coarse mesh_swept(const TriSurface& surface, long target_hexes = 2500) {
 
 // Issue 3's coarse element targets (0 inverted, scaled Jacobian min >= 0.3 and mean >= 0.85, kappa max <= 10
 // at about 2,500 hexes), which the overlay grid misses on both bones (means 0.79 / 0.76 along the axes,
-// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-22 (no Newton sweeps, the tips reached):
-// built-in mandible 2,512 hexes, 0.569 / 0.904, kappa 5.99, Hausdorff 1.07 mean edges, volume -3.97 %; real
-// jaw 2,546 hexes, 0.421 / 0.891, kappa 9.26, 0.88 mean edges, -3.65 %. The fidelity is what the swept
-// core gives up (1.71 / 1.49 mean edges before the tips were reached; 0.64 along the axes), and neither
-// bone's volume is within 3 % without --fit-volume.
+// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-23 (no Newton sweeps, the tips reached
+// down to the floor of 0.35, the interior relaxed around them): built-in mandible 2,512 hexes, 0.350 /
+// 0.899, kappa 8.64, Hausdorff 0.51 mean edges, volume -3.90 %; real jaw 2,546 hexes, 0.352 / 0.879, kappa
+// 9.49, 0.86 mean edges, -3.40 %. The fidelity is what the swept core gives up (1.71 / 1.49 mean edges
+// before the tips were reached; 0.64 along the axes), and neither bone's volume is within 3 % without
+// --fit-volume.
 TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
   const Coarse m = mesh_swept(generate_mandible({}).surface);
   const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
@@ -157,12 +158,24 @@ TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
     EXPECT_EQ(c->report.attempts, 2);
     EXPECT_NEAR(double(c->hexes), 2500.0, 250.0);
     EXPECT_EQ(c->quality.inverted, 0);
-    EXPECT_GE(c->quality.scaled_jacobian.min, 0.4);
-    EXPECT_GE(c->quality.scaled_jacobian.mean, 0.88);
+    EXPECT_GE(c->quality.scaled_jacobian.min, 0.34);
+    EXPECT_GE(c->quality.scaled_jacobian.mean, 0.87);
     EXPECT_LE(c->quality.condition.max, 9.6);
     EXPECT_LT(std::fabs(c->report.fidelity.volume_difference), 0.045);
     EXPECT_LT(c->report.fidelity.hausdorff, 1.25 * c->report.fidelity.mean_edge_length);
   }
+}
+
+// The built-in mandible's condyle poles at 2,500 hexes: the last tips pass may take a hex down to a scaled
+// Jacobian of 0.35 and up to kappa 9.5, and the interior nodes around the moved nodes then relax (the
+// boundary held) before the tips go on; the Hausdorff distance 1.07 -> 0.51 mean edges (measured
+// 2026-11-23; 0.63 with the floor alone, 1.07 with the worst element never worse).
+TEST(SweptCore, MandibleReachesItsCondylePolesAt2500) {
+  const Coarse m = mesh_swept(generate_mandible({}).surface);
+  EXPECT_EQ(m.quality.inverted, 0);
+  EXPECT_GE(m.quality.scaled_jacobian.min, 0.34);
+  EXPECT_LE(m.quality.condition.max, 9.6);
+  EXPECT_LT(m.report.fidelity.hausdorff, 0.6 * m.report.fidelity.mean_edge_length);
 }
 
 // A corner of the generator's ranges (a 40 mm ramus in a 75 mm arch, 20 mm body): the swept core without
@@ -180,8 +193,8 @@ TEST(SweptCore, InvertedHexesRetryWithNewtonSweeps) {
   const Coarse c = mesh_swept(generate_mandible(corner).surface, 4000);
   EXPECT_EQ(c.report.attempts, 4);
   EXPECT_EQ(c.quality.inverted, 0);
-  EXPECT_GT(c.quality.scaled_jacobian.min,
-            0.0);  // measured 0.064: valid, not good (--core auto: the grid core)
+  // Measured 0.064: valid, not good (--core auto takes the grid core there).
+  EXPECT_GT(c.quality.scaled_jacobian.min, 0.0);
 }
 
 // `hexbite mesh --core swept` meshes along the arch (implied) and says so in its JSON.
