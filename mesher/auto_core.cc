@@ -64,6 +64,7 @@ HexMesh grid_mesh_auto_core(const TriSurface& surface, GridMeshOptions options, 
     return swept;
   }
   HexMesh grid = grid_core("");
+  report->seconds_total += swept_report.seconds_total;  // the time of both meshes
   const QualitySummary& g = report->optimize.phases.back().quality;
   const bool grid_better =
       g.inverted != s.inverted ? g.inverted < s.inverted : worst_measure(g) > worst_measure(s);
@@ -71,6 +72,7 @@ HexMesh grid_mesh_auto_core(const TriSurface& surface, GridMeshOptions options, 
     *choice = {false, "the swept core left " + missed + "; the grid core did better"};
     return grid;
   }
+  swept_report.seconds_total += report->seconds_total;
   *report = std::move(swept_report);
   *choice = {true, "the swept core left " + missed + ", the grid core no better"};
   return swept;
