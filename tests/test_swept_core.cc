@@ -143,10 +143,10 @@ Coarse mesh_swept(const TriSurface& surface, long target_hexes = 2500) {
 
 // Issue 3's coarse element targets (0 inverted, scaled Jacobian min >= 0.3 and mean >= 0.85, kappa max <= 10
 // at about 2,500 hexes), which the overlay grid misses on both bones (means 0.79 / 0.76 along the axes,
-// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-23 (no Newton sweeps, the tips reached
-// down to the floor of 0.35, the interior relaxed around them): built-in mandible 2,512 hexes, 0.350 /
-// 0.899, kappa 8.64, Hausdorff 0.51 mean edges, volume -3.90 %; real jaw 2,546 hexes, 0.352 / 0.879, kappa
-// 9.49, 0.86 mean edges, -3.40 %. The fidelity is what the swept core gives up (1.71 / 1.49 mean edges
+// 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-23 on 9a7ee3d (no Newton sweeps, the tips
+// reached down to the floor of 0.35, the interior relaxed around them, whole cells along the arch):
+// built-in mandible 2,545 hexes, 0.353 / 0.900, kappa 8.94, Hausdorff 0.53 mean edges, volume -4.04 %; real
+// jaw 2,546 hexes, 0.351 / 0.877, kappa 9.50, 0.79 mean edges, -3.55 %. The fidelity is what the swept core gives up (1.71 / 1.49 mean edges
 // before the tips were reached; 0.64 along the axes), and neither bone's volume is within 3 % without
 // --fit-volume.
 TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
@@ -169,7 +169,8 @@ TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
 // The built-in mandible's condyle poles at 2,500 hexes: the last tips pass may take a hex down to a scaled
 // Jacobian of 0.35 and up to kappa 9.5, and the interior nodes around the moved nodes then relax (the
 // boundary held) before the tips go on; the Hausdorff distance 1.07 -> 0.51 mean edges (measured
-// 2026-11-23; 0.63 with the floor alone, 1.07 with the worst element never worse).
+// 2026-11-23 on b694489; 0.63 with the floor alone, 1.07 with the worst element never worse; 0.53 with whole
+// cells along the arch, 9a7ee3d).
 TEST(SweptCore, MandibleReachesItsCondylePolesAt2500) {
   const Coarse m = mesh_swept(generate_mandible({}).surface);
   EXPECT_EQ(m.quality.inverted, 0);
