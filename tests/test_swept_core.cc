@@ -146,8 +146,9 @@ Coarse mesh_swept(const TriSurface& surface, long target_hexes = 2500) {
 // 0.82 / 0.78 along the arch; docs/meshing.md). Measured 2026-11-23 on 9a7ee3d (no Newton sweeps, the tips
 // reached down to the floor of 0.35, the interior relaxed around them, whole cells along the arch):
 // built-in mandible 2,545 hexes, 0.353 / 0.900, kappa 8.94, Hausdorff 0.53 mean edges, volume -4.04 %; real
-// jaw 2,546 hexes, 0.351 / 0.877, kappa 9.50, 0.79 mean edges, -3.55 %. The fidelity is what the swept core gives up (1.71 / 1.49 mean edges
-// before the tips were reached; 0.64 along the axes), and neither bone's volume is within 3 % without
+// jaw 2,546 hexes, 0.351 / 0.877, kappa 9.50, 0.79 mean edges, -3.55 %. The fidelity is what the swept core
+// gives up (1.71 / 1.49 mean edges before the tips were reached; 0.64 along the axes), and neither bone's
+// volume is within 3 % without
 // --fit-volume.
 TEST(SweptCore, MandibleAndJawAt2500MeetTheCoarseElementTargets) {
   const Coarse m = mesh_swept(generate_mandible({}).surface);
