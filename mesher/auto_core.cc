@@ -1,33 +1,24 @@
 #include "mesher/auto_core.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <utility>
 
+#include "common/number_format.h"
 #include "mesher/arch_frame.h"
 
 namespace hexbite {
 
 namespace {
 
-std::string format(const char* pattern, double a, double b = 0) {
-  char text[160];
-  std::snprintf(text, sizeof text, pattern, a, b);
-  return text;
-}
-
-double worst_measure(const QualitySummary& q) {
-  return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
-}
-
 // What keeps a swept mesh from the bounds, or empty.
 std::string shortfall(const QualitySummary& q, const AutoCoreOptions& bounds) {
   if (q.inverted > 0) return std::to_string(q.inverted) + " inverted hexes";
   if (q.scaled_jacobian.min < bounds.min_scaled_jacobian)
-    return format("a scaled Jacobian of %.3f (below %.2f)", q.scaled_jacobian.min,
-                  bounds.min_scaled_jacobian);
+    return "a scaled Jacobian of " + format_table_number(q.scaled_jacobian.min, 3, 0) + " (below " +
+           format_significant(bounds.min_scaled_jacobian) + ")";
   if (q.condition.max > bounds.max_condition)
-    return format("a condition number of %.2f (above %.3g)", q.condition.max, bounds.max_condition);
+    return "a condition number of " + format_table_number(q.condition.max, 2, 0) + " (above " +
+           format_significant(bounds.max_condition) + ")";
   return "";
 }
 
@@ -66,8 +57,8 @@ HexMesh grid_mesh_auto_core(const TriSurface& surface, GridMeshOptions options, 
   HexMesh grid = grid_core("");
   report->seconds_total += swept_report.seconds_total;  // the time of both meshes
   const QualitySummary& g = report->optimize.phases.back().quality;
-  const bool grid_better =
-      g.inverted != s.inverted ? g.inverted < s.inverted : worst_measure(g) > worst_measure(s);
+  const bool grid_better = g.inverted != s.inverted ? g.inverted < s.inverted
+                                                    : worst_element_measure(g) > worst_element_measure(s);
   if (grid_better) {
     *choice = {false, "the swept core left " + missed + "; the grid core did better"};
     return grid;

@@ -1177,6 +1177,47 @@ void pillow_and_optimize(GridAttempt& attempt, const SurfaceProjector& projector
   r.seconds_optimize = seconds_since(t0);
 }
 
+// The swept core's tips again, after the optimizer and the mean stage moved the nodes, down to the floor
+// (GridMeshOptions::swept_tips_*); then the interior nodes around the moved nodes restore the quality (the
+// boundary held) and the tips go on from there. A round that takes the mesh's worst below the floor or
+// above the cap is undone.
+void reach_swept_tips(HexMesh& mesh, const SurfaceProjector& projector, const GridMeshOptions& options) {
+  FarSurfaceOptions far;
+  far.limit = options.swept_tips_limit;
+  far.floor_scaled_jacobian = options.swept_tips_floor;
+  far.max_condition = options.swept_tips_condition;
+  FarSurfaceReport tips = reach_far_surface(mesh, projector, far);
+  const std::vector<char> boundary = boundary_vertex_mask(mesh);
+  const std::vector<char> sliding(mesh.vertices.size(), 0);
+  std::vector<std::vector<int>> hexes_of(mesh.vertices.size());
+  for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
+    for (int v : mesh.hexes[e]) hexes_of[v].push_back(int(e));
+  // The worst-element pass keeps min(SJ, 3 / kappa), so where kappa is near the cap it may take a hex's
+  // scaled Jacobian below the floor: such a round is undone (the 40 mm-wide ramus at 2,500 hexes: 0.326).
+  QualitySummary worst = summarize_quality(mesh);
+  const double sj_floor = std::min(worst.scaled_jacobian.min, options.swept_tips_floor);
+  const double kappa_cap = std::max(worst.condition.max, options.swept_tips_condition);
+  for (int relax = 0; relax < options.swept_tips_relax_rounds && !tips.moved.empty(); ++relax) {
+    const std::vector<Vec3> before = mesh.vertices;
+    std::vector<char> movable(mesh.vertices.size(), 0);
+    for (int v : tips.moved)
+      for (int e : hexes_of[v])
+        for (int w : mesh.hexes[e]) movable[w] = !boundary[w];
+    improve_worst_elements(mesh, movable, sliding, &projector, options.optimize);
+    improve_mean_jacobian(mesh, movable, sliding, &projector, options.optimize);
+    tips = reach_far_surface(mesh, projector, far);
+    worst = summarize_quality(mesh);
+    if (worst.inverted > 0 || worst.scaled_jacobian.min < sj_floor || worst.condition.max > kappa_cap) {
+      mesh.vertices = before;
+      break;
+    }
+  }
+}
+
+double worst_element_measure(const QualitySummary& q) {
+  return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
+}
+
 HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
   if (options.target_hexes < 8)
     throw InputError("grid mesher: the target hex count must be at least 8, got " +
@@ -1229,16 +1270,13 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   // then the largest worst-element measure min(scaled Jacobian, 3 / kappa), is kept.
   const double shifts[] = {0.0, 0.5, 0.25};
   const int grids = std::clamp(options.grids, 1, 3);
-  auto worst_measure = [](const QualitySummary& q) {
-    return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
-  };
   // With fine cells, between two grids whose worst-element measures are both at least mean_tie_break the
   // higher mean (before the mean stage) wins: both minima meet the targets, the mean decides.
   auto better = [&](const GridAttempt& x, const GridAttempt& y) {
     const QualitySummary& q = x.report.optimize.phases.back().quality;
     const QualitySummary& r = y.report.optimize.phases.back().quality;
     if (q.inverted != r.inverted) return q.inverted < r.inverted;
-    const double wq = worst_measure(q), wr = worst_measure(r);
+    const double wq = worst_element_measure(q), wr = worst_element_measure(r);
     if (x.fine && y.fine && wq >= options.mean_tie_break && wr >= options.mean_tie_break)
       return q.scaled_jacobian.mean > r.scaled_jacobian.mean;
     return wq > wr;
@@ -1352,7 +1390,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     for (int a = from; a < job_count; ++a)
       if (better(attempts[a], attempts[best])) best = a;
   };
-  auto worst_of = [&](int a) { return worst_measure(attempts[a].report.optimize.phases.back().quality); };
+  auto worst_of = [&](int a) {
+    return worst_element_measure(attempts[a].report.optimize.phases.back().quality);
+  };
   // Where every fine attempt has a defect (a worst-element measure below retry_below, 0.3, not a minimum
   // merely short of 0.5), the grids with margin everywhere may do better (the real jaw at 35,000 hexes:
   // 0.19 at best with the fine cores, 0.352 / 0.306 with margin everywhere on the half- / quarter-shifted
@@ -1400,40 +1440,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     report.seconds_optimize += seconds_since(t0);
   }
   if (swept && options.swept_reach_far > 0 && report.optimize.inverted == 0) {
-    // The swept core's tips again, after the optimizer and the mean stage moved the nodes, down to the
-    // floor; then the interior nodes around the moved nodes restore the quality (the boundary held) and the
-    // tips go on from there.
     t0 = std::chrono::steady_clock::now();
-    FarSurfaceOptions far;
-    far.limit = options.swept_tips_limit;
-    far.floor_scaled_jacobian = options.swept_tips_floor;
-    far.max_condition = options.swept_tips_condition;
-    FarSurfaceReport tips = reach_far_surface(mesh, projector, far);
-    const std::vector<char> boundary = boundary_vertex_mask(mesh);
-    const std::vector<char> sliding(mesh.vertices.size(), 0);
-    std::vector<std::vector<int>> hexes_of(mesh.vertices.size());
-    for (std::size_t e = 0; e < mesh.hexes.size(); ++e)
-      for (int v : mesh.hexes[e]) hexes_of[v].push_back(int(e));
-    // The worst-element pass keeps min(SJ, 3 / kappa), so where kappa is near the cap it may take a hex's
-    // scaled Jacobian below the floor: such a round is undone (the 40 mm-wide ramus at 2,500 hexes: 0.326).
-    QualitySummary worst = summarize_quality(mesh);
-    const double sj_floor = std::min(worst.scaled_jacobian.min, options.swept_tips_floor);
-    const double kappa_cap = std::max(worst.condition.max, options.swept_tips_condition);
-    for (int relax = 0; relax < options.swept_tips_relax_rounds && !tips.moved.empty(); ++relax) {
-      const std::vector<Vec3> before = mesh.vertices;
-      std::vector<char> movable(mesh.vertices.size(), 0);
-      for (int v : tips.moved)
-        for (int e : hexes_of[v])
-          for (int w : mesh.hexes[e]) movable[w] = !boundary[w];
-      improve_worst_elements(mesh, movable, sliding, &projector, options.optimize);
-      improve_mean_jacobian(mesh, movable, sliding, &projector, options.optimize);
-      tips = reach_far_surface(mesh, projector, far);
-      worst = summarize_quality(mesh);
-      if (worst.inverted > 0 || worst.scaled_jacobian.min < sj_floor || worst.condition.max > kappa_cap) {
-        mesh.vertices = before;
-        break;
-      }
-    }
+    reach_swept_tips(mesh, projector, options);
     PhaseQuality& final_phase = report.optimize.phases.back();
     final_phase.quality = summarize_quality(mesh);
     final_phase.seconds += seconds_since(t0);

@@ -215,6 +215,10 @@ struct GridMeshReport {
   double seconds_core = 0, seconds_pillow = 0, seconds_optimize = 0, seconds_fidelity = 0, seconds_total = 0;
 };
 
+// The worst-element measure by which meshes are compared (after the count of inverted hexes): the smaller
+// of the smallest scaled Jacobian and 3 / the largest condition number (a cube scores 1).
+double worst_element_measure(const QualitySummary& quality);
+
 // Meshes the solid. Throws InputError when the target is not positive or when the surface encloses no
 // cell at any size; the returned mesh may contain inverted hexes (report.optimize.inverted says how many).
 HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options,

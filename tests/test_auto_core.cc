@@ -24,8 +24,7 @@ GridMeshOptions target(long hexes) {
 }
 
 double worst_measure(const HexMesh& mesh) {
-  const QualitySummary q = summarize_quality(mesh);
-  return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
+  return worst_element_measure(summarize_quality(mesh));
 }
 
 TEST(AutoCore, CoarseMandibleKeepsTheSweptCore) {
