@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "mesher/units.h"
@@ -24,11 +25,11 @@ constexpr int kTable = 4001;
 constexpr double kMinStretch = 0.2;
 
 [[noreturn]] void not_an_arch(const std::string& why) {
-  throw NotAnArchError(
-      "arch frame: " + why +
-      "; the arch frame needs a whole mandible in the mandible frame (+x left, +y posterior, +z "
-      "superior); use the axis-aligned grid for other solids (--grid-frame axes, in a scenario "
-      "grid_frame: axes)");
+  throw NotAnArchError("arch frame: " + why +
+                           "; the arch frame needs a whole mandible in the mandible frame (+x left, +y "
+                           "posterior, +z superior)",
+                       "use the axis-aligned grid for other solids (--grid-frame axes, in a scenario "
+                       "grid_frame: axes)");
 }
 
 }  // namespace
@@ -118,16 +119,16 @@ ArchFrame::ArchFrame(const TriSurface& surface) {
   // wins; if none does, the first one's reason is reported. Far behind, a ring's curve passes the checks
   // below through its hole, hence the further check of the fallback: the curve runs inside the bone.
   constexpr double kBack[] = {0.3, 1.0};
-  std::string first_reason;
+  std::optional<NotAnArchError> first;
   for (const double back : kBack) {
     try {
       fit(surface, back, back != kBack[0]);
       return;
     } catch (const NotAnArchError& e) {
-      if (first_reason.empty()) first_reason = e.what();
+      if (!first) first = e;
     }
   }
-  throw NotAnArchError(first_reason);
+  throw *first;
 }
 
 void ArchFrame::fit(const TriSurface& surface, double back, bool curve_inside) {

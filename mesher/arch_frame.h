@@ -17,6 +17,7 @@
 // Thread-safe after construction (const).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "common/error.h"
@@ -27,9 +28,17 @@ namespace hexbite {
 // The surface follows no arch in the mandible frame: an InputError of the frame itself, so that a caller can
 // tell it from the grid mesher's other input errors (a scenario blames its grid_frame line for this one
 // only).
+// Its message is the reason followed by the way out, which depends on who asked for the frame (the grid
+// frame: the axis-aligned grid; the swept core: the grid core).
 class NotAnArchError : public InputError {
  public:
-  using InputError::InputError;
+  NotAnArchError(const std::string& reason, const std::string& way_out)
+      : InputError(reason + "; " + way_out), reason_(reason) {}
+  // Why the surface follows no arch, without the way out.
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string reason_;
 };
 
 class ArchFrame {

@@ -1239,9 +1239,8 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     } catch (const NotAnArchError& e) {
       if (!options.swept_core) throw;
       // The arch frame's way out, the axis-aligned grid, is refused with the swept core: name the grid core.
-      const std::string message = e.what();
-      throw NotAnArchError(message.substr(0, message.find("; use the axis-aligned grid")) +
-                           "; the swept core lies along the arch: use the grid core for other solids (--core "
+      throw NotAnArchError(e.reason(),
+                           "the swept core lies along the arch: use the grid core for other solids (--core "
                            "grid --grid-frame axes, in a scenario core: grid and grid_frame: axes)");
     }
     straightened = surface;
