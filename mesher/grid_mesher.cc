@@ -848,12 +848,41 @@ int add_pillow_layer(HexMesh& mesh, const SurfaceProjector& surface, double h) {
   return int(q.quads.size());
 }
 
-// Surface regions farther than `limit` from the mesh boundary, grouped by shared triangle vertices. A
-// region that is a whole shell of a surface with several shells, far everywhere (every vertex and centroid),
-// is named as a separate shell (a body) or a void that the mesh does not reach.
-std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const Shells& shells,
+// The solid's thickness under a region of its surface: the median, over the region's triangles, of the
+// distance from the centroid along the inward normal to the next surface crossing (0 when no ray crosses).
+// The median: on a blade (a coronoid process) most triangles lie on its two faces, whose rays cross it,
+// while those on its rim run along it.
+double region_thickness(const SurfaceProjector& solid, const std::vector<int>& triangles) {
+  const TriSurface& surface = solid.surface();
+  std::vector<double> depth;
+  for (int t : triangles) {
+    const auto& tri = surface.triangles[t];
+    const Vec3& a = surface.vertices[tri[0]];
+    const Vec3 n = cross(sub(surface.vertices[tri[1]], a), sub(surface.vertices[tri[2]], a));
+    const double len = norm(n);
+    if (len == 0) continue;
+    const Vec3 inward = scale(n, -1.0 / len);
+    const Vec3 c = scale(add(add(a, surface.vertices[tri[1]]), surface.vertices[tri[2]]), 1.0 / 3.0);
+    // Started a hair inside so that the ray does not hit its own triangle.
+    const double hair = 1e-6 * std::sqrt(len);
+    SurfacePoint hit;
+    if (solid.first_hit(add(c, scale(inward, hair)), inward, kInf, &hit))
+      depth.push_back(hit.distance + hair);
+  }
+  if (depth.empty()) return 0.0;
+  std::nth_element(depth.begin(), depth.begin() + depth.size() / 2, depth.end());
+  return depth[depth.size() / 2];
+}
+
+// Surface regions farther than `limit` (half the mean edge) from the mesh boundary, grouped by shared
+// triangle vertices. A region that is a whole shell of a surface with several shells, far everywhere
+// (every vertex and centroid), is named as a separate shell (a body) or a void that the mesh does not
+// reach; any other region is named by the solid's thickness under it: a part thinner than the mean edge,
+// or an edge, corner or tip of a thicker one.
+std::vector<UnresolvedPart> unresolved_regions(const SurfaceProjector& solid, const Shells& shells,
                                                const std::vector<double>& vertex_dist,
                                                const std::vector<double>& centroid_dist, double limit) {
+  const TriSurface& surface = solid.surface();
   const std::size_t nt = surface.triangles.size();
   UnionFind pieces(surface.vertices.size());
   std::vector<char> far_triangle(nt, 0);
@@ -871,6 +900,7 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
   std::vector<Vec3> sums, lows, highs;
   std::vector<int> shell_of_part;
   std::vector<long> wholly_far;  // per part: triangles whose vertices and centroid are all far
+  std::vector<std::vector<int>> triangles_of_part;
   for (std::size_t t = 0; t < nt; ++t) {
     if (!far_triangle[t]) continue;
     const auto& tri = surface.triangles[t];
@@ -883,7 +913,9 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
       highs.push_back({-kInf, -kInf, -kInf});
       shell_of_part.push_back(shells.shell_of_triangle[t]);
       wholly_far.push_back(0);
+      triangles_of_part.emplace_back();
     }
+    triangles_of_part[region[root]].push_back(int(t));
     UnresolvedPart& p = parts[region[root]];
     const Vec3& a = surface.vertices[tri[0]];
     const Vec3& b = surface.vertices[tri[1]];
@@ -921,10 +953,23 @@ std::vector<UnresolvedPart> unresolved_regions(const TriSurface& surface, const 
           "; ask for more hexes to resolve it";
       continue;
     }
+    parts[r].thickness = region_thickness(solid, triangles_of_part[r]);
+    const double mean_edge = 2.0 * limit;
+    std::ostringstream why;
+    why.precision(1);
+    why << std::fixed;
+    if (parts[r].thickness == 0)
+      why << "a part the mesh does not reach at this size; ask for more hexes to resolve it";
+    else if (parts[r].thickness < mean_edge)
+      why << "a part about " << parts[r].thickness << " mm thick, thinner than the mean edge (" << mean_edge
+          << " mm); ask for more hexes to resolve it";
+    else
+      why << "an edge, corner or tip of a part about " << parts[r].thickness
+          << " mm thick that the mesh cuts at this size (mean edge " << mean_edge
+          << " mm); ask for more hexes to follow it closer";
     parts[r].what = std::string(shells.inner[shell] ? "the void's surface near " : "the surface near ") +
                     format_point_mm(parts[r].location) + " lies up to " + extent.str() +
-                    " mm from the mesh (" + std::to_string(parts[r].samples) +
-                    " triangles): a part too thin for this cell size; ask for more hexes to resolve it";
+                    " mm from the mesh (" + std::to_string(parts[r].samples) + " triangles): " + why.str();
   }
   std::stable_sort(parts.begin(), parts.end(),
                    [](const UnresolvedPart& a, const UnresolvedPart& b) { return a.extent > b.extent; });
@@ -1044,7 +1089,8 @@ MeshFidelity measure_fidelity(const HexMesh& mesh, const SurfaceProjector& surfa
   f.mesh_volume = hex_mesh_volume(mesh);
   f.surface_volume = enclosed_volume(s);
   f.volume_difference = f.surface_volume != 0 ? (f.mesh_volume - f.surface_volume) / f.surface_volume : 0.0;
-  f.unresolved = unresolved_regions(s, find_shells(s), vertex_dist, centroid_dist, 0.5 * f.mean_edge_length);
+  f.unresolved =
+      unresolved_regions(surface, find_shells(s), vertex_dist, centroid_dist, 0.5 * f.mean_edge_length);
   return f;
 }
 

@@ -178,7 +178,10 @@ struct UnresolvedPart {
   Vec3 location{};    // centroid of the region, mm
   double extent = 0;  // largest distance of the region's surface from the mesh boundary, mm
   int samples = 0;    // surface samples (vertices and triangle centroids) in the region
-  std::string what;   // one sentence
+  // The solid's thickness under the region (the median inward ray through it), mm; 0 for a whole shell or
+  // where no ray crosses the solid.
+  double thickness = 0;
+  std::string what;  // one sentence
   // Set by name_unresolved_parts: the nearest landmark and the nearest muscle insertion, nearest first
   // (empty without landmarks).
   std::vector<NearbyPoint> near;

@@ -63,6 +63,7 @@ nlohmann::json fidelity_to_json(const MeshFidelity& f) {
     unresolved.push_back({{"location", u.location},
                           {"extent_mm", u.extent},
                           {"samples", u.samples},
+                          {"thickness_mm", u.thickness},
                           {"near", near},
                           {"what", u.what}});
   }
