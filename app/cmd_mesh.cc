@@ -274,7 +274,7 @@ void run_mesh(const MeshOptions& o) {
   const QualitySummary& final_quality = report.optimize.phases.back().quality;
   const bool valid = final_quality.inverted == 0;
   const bool write = valid || o.allow_invalid;
-  if (write) write_vtu(o.output, mesh);
+  if (write) write_hex_mesh(o.output, mesh);
 
   if (o.json)
     std::cout << report_json(o, mesh, report, choice, write).dump(2) << '\n';
@@ -321,7 +321,11 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option("--target-hexes", o->target, "Wanted number of hexes (8 to 5,000,000)")
       ->default_val(2500)
       ->transform(count_in_range(kMinTargetHexes, kMaxTargetHexes));
-  cmd->add_option("-o,--output", o->output, "Output mesh (.vtu)")->required()->check(output_file({".vtu"}));
+  cmd->add_option("-o,--output", o->output,
+                  "Output mesh: .vtu (with per-hex quality arrays), .inp (Abaqus / CalculiX: nodes and C3D8 "
+                  "elements) or .msh (Gmsh 4.1)")
+      ->required()
+      ->check(output_hex_mesh_file());
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   cmd->add_option("--margin", o->margin,
                   "Core cells of the overlay grid (--method grid) have their centre at least this many "

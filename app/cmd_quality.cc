@@ -4,7 +4,6 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -135,8 +134,7 @@ void add_quality_command(CLI::App& app) {
   cmd->callback([options, worst_option] {
     const bool list_worst = worst_option->count() > 0;
     // Gmsh meshes are read too, so that peer meshers can be measured with exactly the same code.
-    const std::string ext = std::filesystem::path(options->mesh).extension().string();
-    const HexMesh mesh = (ext == ".msh" || ext == ".MSH") ? read_msh(options->mesh) : read_vtu(options->mesh);
+    const HexMesh mesh = read_hex_mesh(options->mesh);
     const HexQualityField field = compute_hex_quality(mesh);
     const QualitySummary summary = summarize_quality(mesh, field);
     const std::vector<WorstHex> worst = worst_hexes(mesh, field, static_cast<std::size_t>(options->worst));

@@ -207,7 +207,7 @@ void require_no_inverted_hexes(const HexMesh& coarse, const RefineCliOptions& o)
 void run_refine(const RefineCliOptions& o) {
   if (o.fit_volume && o.surface.empty())
     throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
-  const HexMesh coarse = read_vtu(o.mesh);
+  const HexMesh coarse = read_hex_mesh(o.mesh);
   const long long refined = static_cast<long long>(coarse.hexes.size()) << (3 * o.levels);
   if (refined > kMaxRefinedHexes)
     throw InputError("--levels " + std::to_string(o.levels) + " would turn the " +
@@ -227,7 +227,7 @@ void run_refine(const RefineCliOptions& o) {
   RefineReport report;
   const HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
   const bool valid = report.after.inverted == 0;
-  if (valid) write_vtu(o.output, fine);
+  if (valid) write_hex_mesh(o.output, fine);
 
   if (o.json)
     std::cout << report_json(o, report, valid).dump(2) << '\n';
@@ -250,12 +250,15 @@ void add_refine_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "refine",
       "Split every hex into 8 (boundary nodes onto the surface), for coarse-against-fine validation");
-  cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu)")->required();
+  cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
   cmd->add_option(
       "--surface", o->surface,
       "Closed surface the mesh fills (.stl .obj .ply .off .vtp); new boundary nodes are projected "
       "onto it. Without it the refinement is purely parametric");
-  cmd->add_option("-o,--output", o->output, "Refined mesh (.vtu)")->required()->check(output_file({".vtu"}));
+  cmd->add_option("-o,--output", o->output,
+                  "Refined mesh: .vtu (with per-hex quality arrays), .inp (Abaqus / CalculiX) or .msh (Gmsh)")
+      ->required()
+      ->check(output_hex_mesh_file());
   cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "After the refinement, move the new boundary nodes off the --surface until the boundary "

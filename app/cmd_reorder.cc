@@ -72,7 +72,7 @@ void run_reorder(const ReorderOptions& o) {
         "--from and --landmarks choose where the breadth-first order starts; --method rcm picks "
         "its own start, so leave them out or use --method bfs");
   std::vector<MeshArray> cell_arrays, point_arrays;
-  const HexMesh mesh = read_vtu(o.mesh, &cell_arrays, &point_arrays);
+  const HexMesh mesh = read_hex_mesh(o.mesh, &cell_arrays, &point_arrays);
 
   const auto t0 = std::chrono::steady_clock::now();
   ReorderResult r;
@@ -112,8 +112,8 @@ void run_reorder(const ReorderOptions& o) {
     r = reorder_reverse_cuthill_mckee(mesh);
   }
   const double seconds = seconds_since(t0);
-  write_vtu(o.output, r.mesh, permute_arrays(cell_arrays, r.hex_order),
-            permute_arrays(point_arrays, r.node_order));
+  write_hex_mesh(o.output, r.mesh, permute_arrays(cell_arrays, r.hex_order),
+                 permute_arrays(point_arrays, r.node_order));
 
   if (o.json) {
     nlohmann::json j;
@@ -159,10 +159,12 @@ void add_reorder_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "reorder",
       "Renumber hexes and nodes (breadth-first or reverse Cuthill-McKee) to shrink the matrix bandwidth");
-  cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu)")->required();
-  cmd->add_option("-o,--output", o->output, "Reordered mesh (.vtu)")
+  cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
+  cmd->add_option(
+         "-o,--output", o->output,
+         "Reordered mesh: .vtu (the input's arrays carried over), .inp (Abaqus / CalculiX) or .msh (Gmsh)")
       ->required()
-      ->check(output_file({".vtu"}));
+      ->check(output_hex_mesh_file());
   cmd->add_option(
          "--method", o->method,
          "bfs: breadth-first from a boundary hex (the seed paper's order); rcm: reverse Cuthill-McKee")

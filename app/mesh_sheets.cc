@@ -62,7 +62,7 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
   }
   const bool valid = report.quality.inverted == 0;
   const bool write = valid || o.allow_invalid;
-  if (write) write_vtu(o.output, mesh);
+  if (write) write_hex_mesh(o.output, mesh);
   if (o.json) {
     nlohmann::json j;
     j["quad_surface"] = o.quad_surface;

@@ -240,7 +240,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   const double total_seconds = seconds_since(t0);
   const bool valid = sheet_report.inverted == 0;
   const bool write = valid || o.allow_invalid;
-  if (write) write_vtu(qo.output, mesh);
+  if (write) write_hex_mesh(qo.output, mesh);
   const QualitySummary& q = report.quality;
   if (qo.json) {
     nlohmann::json j;

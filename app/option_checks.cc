@@ -81,6 +81,10 @@ CLI::Validator output_surface_file() {
   return output_file({".stl", ".obj", ".ply", ".off", ".vtp"});
 }
 
+CLI::Validator output_hex_mesh_file() {
+  return output_file({".vtu", ".inp", ".msh"});
+}
+
 CLI::Validator output_folder() {
   return CLI::Validator(
       [](std::string& value) -> std::string {

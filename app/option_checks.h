@@ -21,6 +21,8 @@ CLI::Validator output_file(std::vector<std::string> extensions);
 
 // An output surface: output_file with the formats write_surface knows (.stl, .obj, .ply, .off, .vtp).
 CLI::Validator output_surface_file();
+// An output hex mesh: output_file with the formats write_hex_mesh knows (.vtu, .inp, .msh).
+CLI::Validator output_hex_mesh_file();
 
 // An output folder: a folder or a path that does not exist yet (it is created), never an existing file.
 CLI::Validator output_folder();

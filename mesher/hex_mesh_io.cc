@@ -555,4 +555,38 @@ HexMesh read_msh(const std::string& path) {
   return mesh;
 }
 
+namespace {
+
+// The file name's extension in lower case (".vtu"), empty without one.
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+}  // namespace
+
+void write_hex_mesh(const std::string& path, const HexMesh& mesh, const std::vector<MeshArray>& cell_arrays,
+                    const std::vector<MeshArray>& point_arrays) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".vtu")
+    write_vtu(path, mesh, cell_arrays, point_arrays);
+  else if (ext == ".inp")
+    write_inp(path, mesh);
+  else if (ext == ".msh")
+    write_msh(path, mesh);
+  else
+    throw InputError("cannot write hex mesh '" + path +
+                     "': unknown format; give a file name ending in .vtu, .inp (Abaqus / CalculiX) or .msh "
+                     "(Gmsh)");
+}
+
+HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays,
+                      std::vector<MeshArray>* point_arrays) {
+  if (lower_extension(path) != ".msh") return read_vtu(path, cell_arrays, point_arrays);
+  if (cell_arrays) cell_arrays->clear();
+  if (point_arrays) point_arrays->clear();
+  return read_msh(path);
+}
+
 }  // namespace hexbite

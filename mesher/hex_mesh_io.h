@@ -1,5 +1,5 @@
 // Hex mesh files: VTU (VTK XML unstructured grid) read and write, Gmsh .msh read and write, and the Abaqus /
-// CalculiX .inp export.
+// CalculiX .inp export; write_hex_mesh and read_hex_mesh choose among them by the file name.
 //
 // Input/output: a HexMesh in VTK node order plus optional named per-cell and per-point arrays. Writers are
 // atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
@@ -63,5 +63,17 @@ void write_msh(const std::string& path, const HexMesh& mesh);
 // Reads a Gmsh ASCII .msh file, format 4.1 or 2.2. Points, lines and faces are skipped; hexahedra (type 5)
 // are kept; any other volume element is an InputError. All nodes are kept, in the file's order.
 HexMesh read_msh(const std::string& path);
+
+// The hex mesh formats by the file name's extension (any case): .vtu (write_vtu, with the arrays), .inp
+// (write_inp, nodes and C3D8 elements only) or .msh (write_msh); the arrays go only into a .vtu. Throws
+// InputError for another extension.
+void write_hex_mesh(const std::string& path, const HexMesh& mesh,
+                    const std::vector<MeshArray>& cell_arrays = {},
+                    const std::vector<MeshArray>& point_arrays = {});
+
+// Reads a .msh file (read_msh) by its extension (any case), any other name as a .vtu (read_vtu, which names
+// a file that is not one); the arrays come only from a .vtu (a .msh leaves them empty).
+HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
+                      std::vector<MeshArray>* point_arrays = nullptr);
 
 }  // namespace hexbite

@@ -305,6 +305,61 @@ TEST(HexMeshIo, MshRoundTrip) {
   EXPECT_EQ(read_file(dir + "/m.msh"), read_file(dir + "/n.msh"));
 }
 
+// write_hex_mesh and read_hex_mesh choose the format by the file name, in any case; the arrays go only into
+// and come only from a .vtu.
+TEST(HexMeshIo, FormatByFileName) {
+  const HexMesh mesh = perturbed_block(3, 2, 2);
+  const std::string dir = temp_dir();
+  const MeshArray tag{"tag", 1, std::vector<double>(mesh.hexes.size(), 7.0)};
+  write_hex_mesh(dir + "/m.vtu", mesh, {tag});
+  write_hex_mesh(dir + "/m.MSH", mesh, {tag});
+  write_hex_mesh(dir + "/m.inp", mesh);
+  std::vector<MeshArray> cells, points;
+  const HexMesh from_vtu = read_hex_mesh(dir + "/m.vtu", &cells, &points);
+  EXPECT_EQ(from_vtu.hexes, mesh.hexes);
+  ASSERT_NE(find_array(cells, "tag"), nullptr);
+  const HexMesh from_msh = read_hex_mesh(dir + "/m.MSH", &cells, &points);
+  EXPECT_EQ(from_msh.vertices, mesh.vertices);
+  EXPECT_EQ(from_msh.hexes, mesh.hexes);
+  EXPECT_TRUE(cells.empty());
+  EXPECT_EQ(read_file(dir + "/m.MSH").rfind("$MeshFormat\n4.1", 0), 0u);
+  const ParsedInp inp = parse_inp(read_file(dir + "/m.inp"));
+  EXPECT_EQ(inp.elements, mesh.hexes);
+  const std::string message = test::message_of<InputError>([&] { write_hex_mesh(dir + "/m.stl", mesh); });
+  EXPECT_NE(message.find("give a file name ending in .vtu, .inp (Abaqus / CalculiX) or .msh"),
+            std::string::npos)
+      << message;
+  EXPECT_FALSE(fs::exists(dir + "/m.stl"));
+}
+
+// The commands that write a hex mesh write it as .vtu, .inp or .msh by the name after -o, and the commands
+// that read one read a .msh too: a mesh exported to Gmsh can be refined and reordered (before, only .vtu:
+// "this command writes .vtu", and refine and reorder read .vtu only).
+TEST(HexMeshIo, MeshRefineAndReorderWriteEveryFormat) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/cubes.obj", test::cubes_obj(1));
+  for (const char* ext : {".vtu", ".inp", ".msh"}) {
+    const test::CommandResult r =
+        run_hexbite({"mesh", dir + "/cubes.obj", "--target-hexes", "200", "-o", dir + "/m" + ext, "-q"});
+    ASSERT_EQ(r.exit_code, 0) << ext << ": " << r.err;
+  }
+  const HexMesh vtu = read_vtu(dir + "/m.vtu");
+  EXPECT_EQ(read_msh(dir + "/m.msh").hexes, vtu.hexes);
+  EXPECT_EQ(parse_inp(read_file(dir + "/m.inp")).elements, vtu.hexes);
+
+  test::CommandResult r =
+      run_hexbite({"refine", dir + "/m.msh", "--surface", dir + "/cubes.obj", "-o", dir + "/fine.inp", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(parse_inp(read_file(dir + "/fine.inp")).elements.size(), 8 * vtu.hexes.size());
+  r = run_hexbite({"reorder", dir + "/m.msh", "-o", dir + "/rcm.msh", "--method", "rcm", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_msh(dir + "/rcm.msh").hexes.size(), vtu.hexes.size());
+
+  r = run_hexbite({"mesh", dir + "/cubes.obj", "-o", dir + "/m.stl"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("this command writes .vtu, .inp or .msh"), std::string::npos) << r.err;
+}
+
 TEST(HexMeshIo, MshVersion22WithLowerDimensionalElements) {
   const std::string dir = temp_dir();
   // Gmsh writes boundary quads and points beside the hexes; node tags need not be contiguous.
