@@ -1,6 +1,7 @@
 // hexbite quad check Q.obj [--json]
 // hexbite quad from-mandible SURFACE [--landmarks L.yaml] [--target-quads N] -o Q.obj [--json]
 //   [--refine-at X,Y,Z|LANDMARK [--refine-radius MM] [--refine-levels K]]
+// hexbite quad from-mesh MESH.vtu -o Q.obj [--json]: the boundary quad surface of a hex mesh
 //
 // Reports what the sheet mesher (hexbite mesh --method sheets) needs to know about a quad surface: closed,
 // manifold, genus, even quad count, simple, planar and 3-connected graph, the chords with their lengths and
@@ -18,6 +19,8 @@
 #include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_mesh_io.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 
@@ -135,6 +138,33 @@ void run_quad_check(const QuadCheckOptions& o) {
   }
 }
 
+struct QuadFromMeshOptions {
+  std::string mesh;
+  std::string output;
+  bool json = false;
+};
+
+// The boundary quads of a hex mesh (outward, on the mesh's own boundary vertices), e.g. to mesh the same
+// boundary again by cycle elimination (hexbite mesh --method sheets --quad-surface), which keeps it exactly.
+void run_quad_from_mesh(const QuadFromMeshOptions& o) {
+  const HexMesh mesh = read_hex_mesh(o.mesh);
+  const HexBoundary boundary = extract_boundary(mesh);
+  write_quad_obj(o.output, boundary.surface);
+  if (o.json) {
+    std::cout << nlohmann::json{{"mesh", o.mesh},
+                                {"hexes", mesh.hexes.size()},
+                                {"quads", boundary.surface.quads.size()},
+                                {"vertices", boundary.surface.vertices.size()},
+                                {"output", o.output}}
+                     .dump(2)
+              << std::endl;
+    return;
+  }
+  info("Boundary of " + o.mesh + " (" + std::to_string(mesh.hexes.size()) +
+       " hexes): " + std::to_string(boundary.surface.quads.size()) + " quads, " +
+       std::to_string(boundary.surface.vertices.size()) + " vertices, outward\nwrote " + o.output);
+}
+
 }  // namespace
 
 void add_quad_commands(CLI::App& app) {
@@ -168,6 +198,16 @@ void add_quad_commands(CLI::App& app) {
   fm->add_flag("--json", from->json, "Print the report as one JSON object on standard output");
   add_refine_options(*fm, from->refine);
   fm->callback([from] { run_quad_from_mandible(*from); });
+
+  auto from_mesh = std::make_shared<QuadFromMeshOptions>();
+  CLI::App* fh = quad->add_subcommand(
+      "from-mesh", "The boundary quad surface of a hex mesh (the quads of one hex each, outward)");
+  fh->add_option("MESH", from_mesh->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
+  fh->add_option("-o,--output", from_mesh->output, "Output quad surface (.obj)")
+      ->required()
+      ->check(output_file({".obj"}));
+  fh->add_flag("--json", from_mesh->json, "Print the report as one JSON object on standard output");
+  fh->callback([from_mesh] { run_quad_from_mesh(*from_mesh); });
 }
 
 }  // namespace hexbite

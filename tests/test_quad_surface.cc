@@ -5,6 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "common/error.h"
+#include "mesher/hex_block.h"
+#include "mesher/hex_boundary.h"
+#include "mesher/hex_mesh_io.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 #include "tests/quad_test_surfaces.h"
@@ -309,6 +312,38 @@ TEST(QuadCheckCli, ExitCodesAndMessages) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
     EXPECT_NE(r.out.find("usable for --method sheets: no"), std::string::npos) << c.name;  // report printed
   }
+}
+
+// `quad from-mesh` writes the boundary quads of a hex mesh (.vtu or .msh): for a 2 x 3 x 4 block its 52
+// outward faces on the 54 boundary nodes, a surface that `quad check` passes and the sheet mesher takes.
+TEST(QuadFromMeshCli, BoundaryOfABlock) {
+  const std::string dir = test::temp_dir();
+  const HexMesh block = make_block_mesh(2, 3, 4);
+  write_msh(dir + "/block.msh", block);
+  const auto r = test::run_hexbite({"quad", "from-mesh", dir + "/block.msh", "-o", dir + "/q.obj", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["hexes"], 24);
+  EXPECT_EQ(j["quads"], 52);
+  EXPECT_EQ(j["vertices"], 54);
+  const QuadSurface q = read_quad_surface(dir + "/q.obj");
+  const HexBoundary b = extract_boundary(block);
+  EXPECT_EQ(q.quads, b.surface.quads);
+  EXPECT_EQ(q.vertices, b.surface.vertices);
+  const QuadSurfaceReport report = check_quad_surface(q, "q.obj");
+  EXPECT_TRUE(report.usable());
+  EXPECT_TRUE(report.ball);
+  // The surface encloses the block: positive volume means outward quads.
+  const TriSurface tri = fan_triangles(q);
+  double six_volume = 0;
+  for (const auto& t : tri.triangles) {
+    const Vec3 &a = tri.vertices[t[0]], &b2 = tri.vertices[t[1]], &c = tri.vertices[t[2]];
+    six_volume += a[0] * (b2[1] * c[2] - b2[2] * c[1]) - a[1] * (b2[0] * c[2] - b2[2] * c[0]) +
+                  a[2] * (b2[0] * c[1] - b2[1] * c[0]);
+  }
+  EXPECT_NEAR(six_volume / 6.0, 24.0, 1e-9);
+  const auto bad = test::run_hexbite({"quad", "from-mesh", dir + "/block.msh", "-o", dir + "/q.vtu"});
+  EXPECT_EQ(bad.exit_code, 2);
 }
 
 }  // namespace
