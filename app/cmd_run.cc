@@ -81,10 +81,18 @@ void run_run(const RunCliOptions& o) {
 
   const double size = largest_extent(result.levels.front().mesh.vertices);
   for (const LevelResult& l : result.levels) {
-    if (!(l.solution.equilibrium_residual <= kEquilibriumTolerance))
-      throw RunError("level " + std::to_string(l.level) + ": applied forces and reactions do not balance (" +
-                     "relative residual " + std::to_string(l.solution.equilibrium_residual) + " > 1e-8); " +
-                     "the results in " + o.output + " are not trustworthy: tighten solver.tolerance");
+    if (!(l.solution.equilibrium_residual <= kEquilibriumTolerance)) {
+      // %.3g: std::to_string printed a residual of 3e-8 as "0.000000 > 1e-8".
+      const SolverSpec& solver = result.scenario.solver;
+      char text[160];
+      std::snprintf(text, sizeof text, "relative residual %.3g > 1e-8", l.solution.equilibrium_residual);
+      char tolerance[32];
+      std::snprintf(tolerance, sizeof tolerance, "%g", solver.tolerance);
+      throw RunError(
+          "level " + std::to_string(l.level) + ": applied forces and reactions do not balance (" + text +
+          "); the results in " + o.output + " are not trustworthy: tighten solver.tolerance (" + tolerance +
+          (solver.where.line ? ", solver at " + solver.where.str() : std::string(", the default")) + ")");
+    }
     if (l.solution.max_displacement > kMaxDisplacementFraction * size) {
       char text[400];
       std::snprintf(text, sizeof text,

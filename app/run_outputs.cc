@@ -283,6 +283,23 @@ void check_inp_exportable(const Scenario& scenario) {
       throw InputError(s.where.str() + ": support '" + s.name +
                        "' is a spring (spring_N_per_mm3), which the CalculiX export does not write; "
                        "use fixed components for the comparison with CalculiX, or run without --export inp");
+  // Names that differ only in case or in characters other than letters and digits ("condyle" and
+  // "CONDYLE", "left condyle" and "left_condyle") give one set name: write_inp refused it after the solve
+  // (exit 1, mesh.vtu already written, no results.json). Refused here, before anything runs.
+  std::map<std::string, std::pair<std::string, SourceLocation>> taken;  // set name -> (what, where)
+  const auto claim = [&](const std::string& set, const std::string& what, const SourceLocation& where) {
+    const auto [it, fresh] = taken.emplace(set, std::make_pair(what, where));
+    if (!fresh)
+      throw InputError(
+          where.str() + ": " + what + " and " + it->second.first + " (line " +
+          std::to_string(it->second.second.line) + ") get the same CalculiX set name " + set +
+          " (set names keep letters, digits and '_', in upper case, up to 80 characters), so the "
+          "export would mix their nodes; rename one of them, or run without --export inp");
+  };
+  for (const Support& s : scenario.supports)
+    claim(set_name("SUP_", s.name), "support '" + s.name + "'", s.where);
+  for (const Muscle& m : scenario.muscles)
+    if (m.activation > 0) claim(set_name("MUS_", m.name), "muscle '" + m.name + "'", m.where);
 }
 
 json results_json(const RunResult& r, double seconds_output) {

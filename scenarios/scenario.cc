@@ -637,21 +637,42 @@ std::vector<Muscle> parse_activation_pattern(const Ctx& ctx, const Value& v) {
                                                         : SourceLocation{ctx.file, it->second.Mark().line + 1,
                                                                          it->second.Mark().column + 1};
     const Value value{it->second, value_at, "activation_pattern." + base};
+    // "right_superficial_masseter: 0.5" became left_right_superficial_masseter and
+    // right_right_superficial_masseter, reported as muscles unknown to the landmarks.
+    for (const char* side : {"left_", "right_"})
+      if (base.rfind(side, 0) == 0)
+        fail(key_at, "activation_pattern key " + quote(base) + " starts with " + quote(side) +
+                         ", but a pattern key is a muscle name without its side (the pattern makes both "
+                         "sides' muscles); write " +
+                         base.substr(std::strlen(side)) + ": {" +
+                         std::string(side).substr(0, std::strlen(side) - 1) + ": " +
+                         (value.node.IsScalar() ? value.node.Scalar() : std::string("a")) + "}, or list " +
+                         quote(base) + " in muscles");
+    std::vector<Muscle> added;
     if (value.node.IsMap()) {
       const Map sides(value, {"left", "right"});
       for (const char* side : {"left", "right"})
         if (auto x = sides.find(side)) {
           Muscle m = default_muscle(std::string(side) + "_" + base, sides.key_at(side));
           m.activation = parse_activation(*x);
-          muscles.push_back(m);
+          added.push_back(m);
         }
+      // "superficial_masseter: {}" added no muscle without a word.
+      if (added.empty())
+        fail(value_at, "activation_pattern." + base +
+                           " gives no side; write an activation for both sides (e.g. 0.5) or {left: a, "
+                           "right: b} (either may be left out)");
     } else {
       const double activation = parse_activation(value);
       for (const char* side : {"left", "right"}) {
         Muscle m = default_muscle(std::string(side) + "_" + base, key_at);
         m.activation = activation;
-        muscles.push_back(m);
+        added.push_back(m);
       }
+    }
+    for (Muscle& m : added) {
+      m.pattern_key = base;
+      muscles.push_back(std::move(m));
     }
   }
   return muscles;
@@ -909,6 +930,24 @@ std::optional<std::pair<SourceLocation, char>> unclosed_flow_opener(const std::s
                         open.back().bracket);
 }
 
+// The place of the first tab in the indentation (the blanks that start a line) of the lines up to
+// `last_line` (0-based), or nothing.
+std::optional<SourceLocation> indenting_tab(const std::string& text, int last_line, const std::string& file) {
+  int line = 0, column = 0;
+  bool indenting = true;
+  for (const char c : text) {
+    if (line > last_line) break;
+    if (c == '\n') {
+      ++line, column = 0, indenting = true;
+      continue;
+    }
+    if (indenting && c == '\t') return SourceLocation{file, line + 1, column + 1};
+    if (c != ' ') indenting = false;
+    ++column;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Scenario load_scenario(const std::string& path) {
@@ -931,6 +970,12 @@ Scenario load_scenario(const std::string& path) {
                                 e.msg + ", noticed at line " + std::to_string(where.line) + ", column " +
                                 std::to_string(where.column) + "); add the '" + (sequence ? ']' : '}') +
                                 "' that closes it, and check the commas between its entries");
+    // A tab in the indentation (an editor's, or text pasted from elsewhere) is no YAML; yaml-cpp reports
+    // whatever it makes of the line after it ("illegal map value"), which does not say so.
+    if (const auto tab = indenting_tab(text.str(), e.mark.line, path))
+      fail(*tab, "YAML syntax error: this line is indented with a tab, which YAML does not allow (" + e.msg +
+                     ", noticed at line " + std::to_string(where.line) + ", column " +
+                     std::to_string(where.column) + "); indent with spaces");
     fail(where,
          "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets near this place");
   }
@@ -992,6 +1037,22 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
     const bool uses_defaults = (!m.insertion.resolved && m.insertion.name == m.name + ".insertion") ||
                                (m.origin && !m.origin->resolved && m.origin->name == m.name + ".origin") ||
                                !m.max_force_N;
+    if (line == landmarks.muscles.end() && !m.pattern_key.empty()) {
+      // A pattern muscle takes everything from the landmarks: name the pattern key and the keys that exist.
+      std::vector<std::string> bases;
+      for (const std::string& name : muscle_names)
+        for (const char* side : {"left_", "right_"})
+          if (name.rfind(side, 0) == 0 &&
+              std::find(bases.begin(), bases.end(), name.substr(std::strlen(side))) == bases.end())
+            bases.push_back(name.substr(std::strlen(side)));
+      fail(m.where, "activation_pattern key " + quote(m.pattern_key) + " is no muscle of the landmarks (" +
+                        m.name + " is unknown)" +
+                        (bases.empty() ? "; they have no muscles, so list each muscle in muscles with its "
+                                         "insertion, origin or direction, and max_force_N"
+                                       : "; the closest pattern keys are " +
+                                             join_quoted(closest_names(m.pattern_key, bases, 3)) +
+                                             ": correct the key, or list a muscle of your own in muscles"));
+    }
     if (line == landmarks.muscles.end() && uses_defaults)
       fail(m.where,
            "muscle " + quote(m.name) + " is not a muscle of the landmarks" +
@@ -1001,6 +1062,12 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
                ", so its insertion, origin and max_force_N have no default; correct the name or give all "
                "three ('direction' may replace 'origin')");
     if (!m.max_force_N) m.max_force_N = line->max_force_N;
+    // A landmark file may give a muscle 0 N (the scenario may not); activated, it loads nothing, and with
+    // no other active muscle the run solved a load of zero and reported a bite force of 0 N with exit 0.
+    if (m.activation > 0 && !(*m.max_force_N > 0))
+      fail(m.where, "muscle " + quote(m.name) + " is active (" + fmt(m.activation) +
+                        ") but its max_force_N from the landmarks is 0 N, so it would load nothing; give it "
+                        "a max_force_N in muscles, or set its activation to 0");
     resolve(m.insertion);
     Vec3 d;
     if (m.origin) {
@@ -1083,9 +1150,18 @@ std::vector<int> require_patch_quads(const QuadSurface& boundary, const Vec3& ce
   double nearest = std::numeric_limits<double>::infinity();
   for (const auto& quad : boundary.quads)
     nearest = std::min(nearest, distance(quad_centroid(boundary, quad), center));
-  fail(where, what + " selects no surface facets: no boundary facet centre lies within radius_mm = " +
-                  fmt(radius) + " of " + fmt(center) + ", the nearest is " + fmt(nearest) +
-                  " mm away; increase radius_mm beyond that, move the point onto the bone surface, or refine "
+  const std::string found =
+      what + " selects no surface facets: no boundary facet centre lies within radius_mm = " + fmt(radius) +
+      " of " + fmt(center) + ", the nearest is " + fmt(nearest) + " mm away";
+  // Farther than any patch may reach: a larger radius is no remedy (it is refused), the point is off the
+  // meshed bone (a wrong coordinate or unit, or a part of the bone that a coarse mesh lost).
+  if (nearest > kMaxPatchRadiusMm)
+    fail(where,
+         found + ", farther than any patch reaches (radius_mm is at most " + fmt(kMaxPatchRadiusMm) +
+             " mm), so the point is not on the meshed bone: check its coordinates and their unit, or, if "
+             "the coarse mesh lost that part of the bone, make it finer (mesh.target_hexes)");
+  fail(where, found +
+                  "; increase radius_mm beyond that, move the point onto the bone surface, or refine "
                   "the mesh");
 }
 

@@ -123,6 +123,7 @@ struct Muscle {
   double activation = 0;
   Vec3 line_of_action{};  // unit vector, filled in by resolve_points()
   SourceLocation where;
+  std::string pattern_key;  // the activation_pattern key it came from ("superficial_masseter"), or empty
 };
 
 struct Support {

@@ -499,6 +499,103 @@ outputs: {bite_force: false}
   EXPECT_FALSE(fs::exists(dir));
 }
 
+// A surface file that cannot bound a solid (here a cube with one face missing) is refused at the scenario's
+// geometry line, naming the file; before, the message named only the surface file, not the scenario.
+TEST(RunScenario, SurfaceFileThatCannotBoundASolidIsRefusedAtTheGeometry) {
+  const std::string obj = test::temp_dir() + "/open.obj";
+  std::string cube = test::cubes_obj(1);
+  cube.erase(cube.rfind("f "));  // the last two triangles, one face of the cube
+  cube.erase(cube.rfind("f "));
+  test::write_file(obj, cube);
+  const std::string err = expect_refused(R"(name: open_cube
+geometry:
+  surface: {file: )" + obj + R"(}
+mesh: {target_hexes: 200, validation_levels: 0}
+muscles:
+  - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
+supports:
+  - {name: base, at: [0, 10, 10], radius_mm: 5}
+outputs: {bite_force: false}
+)",
+                                         "cannot bound a solid");
+  EXPECT_NE(err.find("bad.yaml:3:"), std::string::npos) << err;
+  EXPECT_NE(err.find(obj), std::string::npos) << err;
+}
+
+// A box of 10 x 4 x 3 times `scale` as OBJ text (scale 1: a bone of 10 cm written in cm).
+std::string box_obj(double scale) {
+  std::string text;
+  for (int v = 0; v < 8; ++v) {
+    char line[128];
+    std::snprintf(line, sizeof line, "v %g %g %g\n", scale * 10 * (v & 1), scale * 4 * ((v >> 1) & 1),
+                  scale * 3 * ((v >> 2) & 1));
+    text += line;
+  }
+  const std::string cube = test::cubes_obj(1);
+  text += cube.substr(cube.find("f "));
+  return text;
+}
+
+// A surface in the wrong unit: a mandible in cm read as mm is about 12 mm across, which the warning for
+// metres and micrometres (under 0.5 mm, over 3000 mm) let pass, and the run solved it with exit 0 and
+// stresses a hundred times too large (the real jaw in cm: von Mises max 1339 MPa). One in mm read as m was
+// warned of as micrometres. The run warns, naming the unit that gives a mandible-sized bone.
+TEST(RunScenario, SurfaceInAnImplausibleUnitIsWarnedOfWithTheUnitThatFits) {
+  const std::string dir = test::temp_dir();
+  const auto run_box = [&](const std::string& name, double scale, const std::string& units, double at) {
+    test::write_file(dir + "/" + name + ".obj", box_obj(scale));
+    char text[800];
+    std::snprintf(text, sizeof text, R"(name: %s
+geometry:
+  surface: {file: %s.obj%s}
+mesh: {target_hexes: 300, validation_levels: 0}
+muscles:
+  - {name: pull, activation: 1, insertion: [%g, %g, %g], radius_mm: %g, direction: [0, 0, 1], max_force_N: 10}
+supports:
+  - {name: base, at: [0, %g, %g], radius_mm: %g}
+outputs: {bite_force: false}
+)",
+                  name.c_str(), name.c_str(), units.empty() ? "" : (", units: " + units).c_str(), 10 * at,
+                  2 * at, 1.5 * at, std::min(2 * at, 50.0), 2 * at, 1.5 * at, std::min(2 * at, 50.0));
+    test::write_file(dir + "/" + name + ".yaml", text);
+    return test::run_hexbite({"-q", "run", dir + "/" + name + ".yaml", "-o", dir + "/" + name});
+  };
+  // In cm, read as mm: 10 mm across.
+  const test::CommandResult cm = run_box("in_cm", 1.0, "", 1.0);
+  EXPECT_EQ(cm.exit_code, 0) << cm.err;  // a warning, not an error: the grid method meshes any size
+  EXPECT_NE(cm.err.find("in_cm.yaml:3:3: "), std::string::npos) << cm.err;
+  EXPECT_NE(cm.err.find("the surface is 10 mm across (the largest side of its bounding box) with its "
+                        "coordinates read as mm; a mandible is about 100 mm. If the file's coordinates are "
+                        "in cm (100 mm across), write units: cm in geometry.surface"),
+            std::string::npos)
+      << cm.err;
+  // In mm, read as m: 100,000 mm across.
+  const test::CommandResult m = run_box("in_mm", 10.0, "m", 10000.0);
+  EXPECT_NE(m.err.find("the surface is 1e+05 mm across"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("read as m; a mandible is about 100 mm. If the file's coordinates are in mm (100 mm "
+                       "across), write units: mm"),
+            std::string::npos)
+      << m.err;
+  EXPECT_EQ(m.err.find("micrometres"), std::string::npos) << m.err;
+  // In mm, read as mm: no warning.
+  const test::CommandResult mm = run_box("right", 10.0, "", 10.0);
+  EXPECT_EQ(mm.exit_code, 0) << mm.err;
+  EXPECT_EQ(mm.err.find("warning"), std::string::npos) << mm.err;
+}
+
+// Support names that differ only in case or punctuation give one CalculiX set name: the export failed
+// after the solve (exit 1, "write_inp: set name 'SUP_CONDYLE' is reserved or used twice"), leaving mesh.vtu
+// and no results.json. Refused before anything runs, at the later support's line.
+TEST(RunScenario, NamesGivingOneCalculixSetNameAreRefusedForTheExport) {
+  std::string text = kSmall;
+  text.replace(text.find("name: right_condyle"), 19, "name: condyle");
+  text.replace(text.find("name: left_condyle"), 18, "name: CONDYLE");
+  const std::string err = expect_refused(
+      text, "support 'CONDYLE' and support 'condyle' (line 9) get the same CalculiX set name SUP_CONDYLE ",
+      {"--export", "inp"});
+  EXPECT_NE(err.find("bad.yaml:10:"), std::string::npos) << err;
+}
+
 TEST(RunScenario, UnknownKeyIsRefused) {
   expect_refused(kSmall + "solvr: {degree: 1}\n", "did you mean 'solver'?");
 }
@@ -626,6 +723,26 @@ TEST(RunScenario, DisplacementsLargeAgainstTheBoneFailTheRun) {
   EXPECT_NE(r.err.find("level 0: the largest displacement"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("check materials E_MPa"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/out/results.json"));
+}
+
+// A loose solver tolerance leaves the forces unbalanced: the run fails naming the residual, which it used to
+// print with std::to_string ("relative residual 0.000000 > 1e-8" for 3e-8), and the scenario's tolerance.
+TEST(RunScenario, UnbalancedForcesNameTheResidualAndTheTolerance) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/loose.yaml", kSmall + "solver: {linear_solver: cg_amg, tolerance: 1.0e-3}\n");
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/loose.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const std::smatch m = [&] {
+    std::smatch found;
+    std::regex_search(r.err, found, std::regex("relative residual ([0-9.e+-]+) > 1e-8"));
+    return found;
+  }();
+  ASSERT_FALSE(m.empty()) << r.err;
+  EXPECT_GT(std::stod(m[1].str()), 1e-8) << r.err;
+  EXPECT_NE(r.err.find("tighten solver.tolerance (0.001, solver at " + dir + "/loose.yaml:11:"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/out/results.json"));  // kept for inspection
 }
 
 // Three validation levels of a Q2 problem of 4,000 hexes are about 56 million DoFs, some 280 GB: such a run

@@ -249,6 +249,56 @@ TEST(Scenario, ActivationPatternExpandsToBothSides) {
   EXPECT_EQ(*s.muscles[2].max_force_N, 174.8);
 }
 
+// Mistakes in an activation_pattern are named as the pattern's: a key with its side
+// ("right_superficial_masseter: 0.5") and a misspelt key were reported as the muscles
+// 'left_right_superficial_masseter' or 'left_superficial_maseter', which the user never wrote, with the
+// advice to give their insertion, origin and max_force_N (which a pattern cannot); "key: {}" added no
+// muscle without a word.
+TEST(ScenarioErrors, ActivationPatternMistakesAreNamedAsThePatterns) {
+  const std::string base =
+      replace(kValid, "muscles:\n  - name: right_superficial_masseter\n    activation: 0.5\n", "");
+  const std::string prefixed = error_of(base + "activation_pattern:\n  right_superficial_masseter: 0.5\n");
+  EXPECT_ERROR_AT(
+      prefixed, 9,
+      "activation_pattern key 'right_superficial_masseter' starts with 'right_', but a pattern key "
+      "is a muscle name without its side");
+  EXPECT_ERROR_AT(prefixed, 9,
+                  "write superficial_masseter: {right: 0.5}, or list 'right_superficial_masseter'");
+  EXPECT_EQ(prefixed.find("left_right_"), std::string::npos) << prefixed;
+
+  const std::string misspelt =
+      error_of(base + "activation_pattern:\n  superficial_maseter: {right: 0.5}\n", /*resolve=*/true);
+  EXPECT_ERROR_AT(
+      misspelt, 9,
+      "activation_pattern key 'superficial_maseter' is no muscle of the landmarks "
+      "(right_superficial_maseter is unknown); the closest pattern keys are 'superficial_masseter'");
+  EXPECT_EQ(misspelt.find("give all three"), std::string::npos) << misspelt;
+
+  EXPECT_ERROR_AT(error_of(base + "activation_pattern:\n  superficial_masseter: {}\n  deep_masseter: 0.5\n"),
+                  9, "activation_pattern.superficial_masseter gives no side");
+}
+
+// A landmark file may give a muscle 0 N; an active muscle of 0 N loads nothing (alone, the run solved a
+// zero load and reported a bite force of 0 N with exit 0).
+TEST(ScenarioErrors, ActiveMuscleWithoutForceInTheLandmarks) {
+  Landmarks landmarks = generator_landmarks();
+  for (MuscleLine& m : landmarks.muscles)
+    if (m.name == "right_superficial_masseter") m.max_force_N = 0;
+  Scenario s = load_scenario(write_scenario(kValid));
+  try {
+    resolve_points(s, landmarks);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_ERROR_AT(std::string(e.what()), 5,
+                    "muscle 'right_superficial_masseter' is active (0.5) but its max_force_N from the "
+                    "landmarks is 0 N");
+  }
+  // Its own max_force_N, or activation 0, is fine.
+  Scenario own = load_scenario(
+      write_scenario(replace(kValid, "activation: 0.5", "activation: 0.5\n    max_force_N: 100")));
+  EXPECT_NO_THROW(resolve_points(own, landmarks));
+}
+
 TEST(Scenario, MaterialRegionsOverrideTheDefault) {
   Scenario s = load_scenario(write_scenario(kValid + R"(materials:
   default: {E_MPa: 12000}
@@ -581,6 +631,17 @@ TEST(ScenarioErrors, UnclosedBracketIsReportedWhereItOpens) {
                   "YAML syntax error: illegal flow end");
 }
 
+// A tab in the indentation: yaml-cpp said only "illegal map value" at the colon after it (line 3,
+// column 10 here), which does not name the tab.
+TEST(ScenarioErrors, TabInTheIndentationIsNamed) {
+  EXPECT_ERROR_AT(error_of("name: t\ngeometry:\n\tmandible: {}\n"), 3,
+                  "YAML syntax error: this line is indented with a tab, which YAML does not allow");
+  EXPECT_NE(error_of("name: t\ngeometry:\n\tmandible: {}\n").find("bad.yaml:3:1:"), std::string::npos);
+  EXPECT_ERROR_AT(error_of("name: t\ngeometry:\n  \tmandible: {}\n"), 3, "indent with spaces");
+  // A tab elsewhere (after the indentation) is not blamed.
+  EXPECT_EQ(error_of("name:\tt\ngeometry: {mandible: [1, 2\n").find("tab"), std::string::npos);
+}
+
 TEST(ScenarioErrors, YamlSyntaxAndEmptyFiles) {
   EXPECT_ERROR_AT(error_of("name: t\ngeometry: {mandible: [1, 2\n"), 2, "YAML syntax error");
   EXPECT_ERROR_AT(error_of(""), 1, "the scenario file is empty");
@@ -613,7 +674,18 @@ TEST(Patches, AnEmptyPatchIsReportedAtItsScenarioLine) {
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_ERROR_AT(std::string(e.what()), 8, "support 'nut' selects no surface facets");
-    EXPECT_ERROR_AT(std::string(e.what()), 8, "increase radius_mm");
+    // The molar point is some 58 mm from the unit cube: no radius up to the largest (50 mm) would reach
+    // it, so the message no longer advises a larger one (it said "increase radius_mm beyond that").
+    EXPECT_ERROR_AT(std::string(e.what()), 8, "farther than any patch reaches (radius_mm is at most 50 mm)");
+    EXPECT_ERROR_AT(std::string(e.what()), 8, "check its coordinates and their unit");
+    EXPECT_EQ(std::string(e.what()).find("increase radius_mm"), std::string::npos) << e.what();
+  }
+  // A near miss: a larger radius is the remedy.
+  try {
+    require_patch_quads(unit_cube(), {0.5, 0.5, 2}, 0.5, nut.where, "support '" + nut.name + "'");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_ERROR_AT(std::string(e.what()), 8, "the nearest is 1 mm away; increase radius_mm");
   }
   EXPECT_EQ(require_patch_quads(unit_cube(), {0.5, 0.5, 1}, 0.1, nut.where, "support"),
             (std::vector<int>{1}));
