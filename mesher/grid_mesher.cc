@@ -1003,15 +1003,18 @@ void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPar
       if (!n.name.empty()) part.near.push_back(n);
     if (part.near.size() == 2 && part.near[1].distance < part.near[0].distance)
       std::swap(part.near[0], part.near[1]);
-    if (part.near.empty()) continue;
+    // In the sentence only the points within kNearMm: "near" a point 35 mm away misleads (the real jaw's
+    // incisors "near left_anterior_digastric.insertion (35.4 mm)"); the JSON keeps both.
+    constexpr double kNearMm = 20.0;
     std::string names;
     for (const NearbyPoint& n : part.near) {
+      if (n.distance > kNearMm) continue;
       std::ostringstream d;
       d.precision(1);
       d << std::fixed << n.distance;
       names += (names.empty() ? "near " : ", ") + n.name + " (" + d.str() + " mm)";
     }
-    part.what = names + ": " + part.what;
+    if (!names.empty()) part.what = names + ": " + part.what;
   }
 }
 

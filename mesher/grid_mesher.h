@@ -183,7 +183,7 @@ struct UnresolvedPart {
   double thickness = 0;
   std::string what;  // one sentence
   // Set by name_unresolved_parts: the nearest landmark and the nearest muscle insertion, nearest first
-  // (empty without landmarks).
+  // (empty without landmarks); `what` names those within 20 mm.
   std::vector<NearbyPoint> near;
 };
 

@@ -491,6 +491,18 @@ TEST(GridMesher, NamesUnresolvedPartsByTheNearestLandmark) {
   EXPECT_NEAR(parts[0].near[1].distance, 3.0, 1e-12);
   EXPECT_EQ(parts[0].what,
             "near left_middle_temporalis.insertion (1.0 mm), left_coronoid_tip (3.0 mm): " + part.what);
+  // Points farther than 20 mm stay in `near` but not in the sentence (before: "near ... (35.4 mm)").
+  UnresolvedPart far = part;
+  far.location = {0, -40, 22};
+  std::vector<UnresolvedPart> far_parts{far};
+  name_unresolved_parts(lm, far_parts);
+  ASSERT_EQ(far_parts[0].near.size(), 2u);
+  EXPECT_NEAR(far_parts[0].near[0].distance, 22.0, 1e-12);
+  EXPECT_EQ(far_parts[0].what, part.what);
+  far_parts[0].location = {0, -40, 15};
+  far_parts[0].what = part.what;
+  name_unresolved_parts(lm, far_parts);
+  EXPECT_EQ(far_parts[0].what, "near incisal_point (15.0 mm): " + part.what);
 }
 
 // `hexbite run` on the real jaw at 4,000 hexes printed all 32 regions (its crowns: 1.3-1.7 mm under 4 mm
