@@ -319,8 +319,9 @@ std::string resolve_file(const Ctx& ctx, const Value& v, const std::string& kind
   path = path.lexically_normal();
   std::error_code error;
   if (!fs::is_regular_file(path, error))
-    fail(v.at, kind + " file " + quote(given) + " (resolved to " + quote(path.string()) +
-                   ") does not exist or is not a file; give a path relative to the scenario file's folder or "
+    fail(v.at, kind + " file " + quote(given) +
+                   (path.string() == given ? std::string() : " (resolved to " + quote(path.string()) + ")") +
+                   " does not exist or is not a file; give a path relative to the scenario file's folder or "
                    "an absolute path");
   return path.string();
 }

@@ -232,6 +232,13 @@ TEST(Scenario, RelativeFilesAreResolvedAgainstTheScenarioFolder) {
 
   EXPECT_ERROR_AT(error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: missing.stl}")),
                   3, "surface file 'missing.stl'");
+  // A path that resolves to itself is not repeated (before: "'/x/missing.stl' (resolved to
+  // '/x/missing.stl')").
+  const std::string absolute = dir + "/missing.stl";
+  const std::string message =
+      error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: " + absolute + "}"));
+  EXPECT_NE(message.find("surface file '" + absolute + "' does not exist"), std::string::npos) << message;
+  EXPECT_EQ(message.find("resolved to"), std::string::npos) << message;
 }
 
 TEST(Scenario, ActivationPatternExpandsToBothSides) {
