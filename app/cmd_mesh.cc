@@ -275,6 +275,18 @@ void run_mesh(const MeshOptions& o) {
   const bool valid = final_quality.inverted == 0;
   const bool write = valid || o.allow_invalid;
   if (write) write_hex_mesh(o.output, mesh);
+  // The cell size search stops after 8 trials; on a thin plate, or a solid of a few cells, the count jumps
+  // between cell sizes and can end far from the target (a 1 mm plate of 100 x 100 mm: 2,912 hexes for 500).
+  const double ratio = double(mesh.hexes.size()) / double(o.target);
+  if (write && (ratio > 2.0 || ratio < 0.5)) {
+    std::ostringstream text;
+    text.precision(ratio < 10 ? 2 : 3);
+    text << "hexbite: warning: the mesh has " << mesh.hexes.size() << " hexes, " << ratio
+         << " times --target-hexes " << o.target
+         << ": no cell size tried came closer (the hex count of a thin or small solid jumps between cell "
+            "sizes); another --target-hexes may come closer\n";
+    std::cerr << text.str();
+  }
 
   if (o.json)
     std::cout << report_json(o, mesh, report, choice, write).dump(2) << '\n';
@@ -332,7 +344,7 @@ void add_mesh_command(CLI::App& app) {
                   "cell sizes inside the surface (negative: at most that far outside), on every grid; the "
                   "pillow layer fills the rest (smaller keeps thinner parts in the core). Without it the "
                   "mesher chooses: -0.4, and for fine cells the better of two cores (docs/meshing.md)")
-      ->check(CLI::Range(-0.8, 2.0))
+      ->check(number_in_range(-0.8, 2.0, "from -0.8 to 2"))
       ->default_val(o->margin);
   cmd->add_option("--grid-frame", o->grid_frame,
                   "Frame of the overlay grid for --method grid: axes, or arch (along the dental arch of a "

@@ -21,6 +21,7 @@
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 
@@ -148,6 +149,23 @@ struct QuadFromMeshOptions {
 // boundary again by cycle elimination (hexbite mesh --method sheets --quad-surface), which keeps it exactly.
 void run_quad_from_mesh(const QuadFromMeshOptions& o) {
   const HexMesh mesh = read_hex_mesh(o.mesh);
+  // An inverted hex's faces point inward, so its boundary quads would not be the outward surface claimed
+  // here (a mirrored mesh gives a wholly inward one): refused as bad input, as hexbite refine does.
+  const HexQualityField field = compute_hex_quality(mesh);
+  std::vector<int> inverted;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    if (!(field.jacobian[h] > 0.0)) inverted.push_back(static_cast<int>(h));  // NaN counts as inverted
+  if (!inverted.empty()) {
+    const std::string count = std::to_string(inverted.size());
+    throw InputError("'" + o.mesh + "' has " + count + " inverted " +
+                     (inverted.size() == 1 ? "hex" : "hexes") +
+                     " (a corner Jacobian <= 0), whose faces point inward, so its boundary is not an outward "
+                     "quad surface: " +
+                     hex_list_text(mesh, inverted, 5) +
+                     "; nothing written: re-mesh the surface (hexbite mesh), or find the worst hexes with "
+                     "hexbite quality " +
+                     o.mesh + " --worst " + count);
+  }
   const HexBoundary boundary = extract_boundary(mesh);
   write_quad_obj(o.output, boundary.surface);
   if (o.json) {

@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -113,6 +114,10 @@ LocalRefinementOptions refinement_options(const RefineCommandOptions& r, const L
   Vec3 p{};
   char rest = 0;
   if (std::sscanf(r.at.c_str(), "%lf,%lf,%lf%c", &p[0], &p[1], &p[2], &rest) == 3) {
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw InputError("--refine-at '" + r.at +
+                       "' is not a point: X, Y and Z must be finite numbers in mm (e.g. --refine-at "
+                       "-27.9,-16.8,49.3), or give a landmark name with --landmarks L.yaml");
     options.points = {p};
     return options;
   }

@@ -54,6 +54,24 @@ CLI::Validator count_in_range(long lo, long hi) {
       "");
 }
 
+CLI::Validator number_in_range(double lo, double hi, const std::string& range) {
+  const std::string give = "give a number " + range;
+  return CLI::Validator(
+      [lo, hi, give](std::string& value) -> std::string {
+        double number = 0;
+        std::size_t used = 0;
+        try {
+          number = std::stod(value, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != value.size()) return value + " is not a number: " + give;
+        if (!std::isfinite(number) || number < lo || number > hi) return value + " is out of range: " + give;
+        return {};
+      },
+      "");
+}
+
 CLI::Validator output_file(std::vector<std::string> extensions) {
   return CLI::Validator(
       [extensions](std::string& value) -> std::string {

@@ -14,6 +14,10 @@ namespace hexbite {
 // validator (add it with Option::transform): it rewrites an accepted value to its plain decimal form.
 CLI::Validator count_in_range(long lo, long hi);
 
+// A real number in [lo, hi]: rejects non-numbers, NaN and infinities (CLI::Range lets NaN through, since
+// every comparison with it is false) with a message that gives the range, `range` ("from -0.8 to 2").
+CLI::Validator number_in_range(double lo, double hi, const std::string& range);
+
 // An output file: its folder exists, it is not itself a folder, and it ends (in any case) in one of
 // `extensions` (".vtu", or ".nii.gz"), the formats the command writes. Checked before the work, so a typo
 // in -o does not cost a whole meshing run, and a .txt name never gets a VTU written into it.

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <utility>
 
 #include "common/error.h"
 #include "common/progress.h"
@@ -848,13 +849,13 @@ int add_pillow_layer(HexMesh& mesh, const SurfaceProjector& surface, double h) {
   return int(q.quads.size());
 }
 
-// The solid's thickness under a region of its surface: the median, over the region's triangles, of the
-// distance from the centroid along the inward normal to the next surface crossing (0 when no ray crosses).
-// The median: on a blade (a coronoid process) most triangles lie on its two faces, whose rays cross it,
-// while those on its rim run along it.
+// The solid's thickness under a region of its surface: the median, over the region's triangles weighted by
+// their area, of the distance from the centroid along the inward normal to the next surface crossing (0 when
+// no ray crosses). The median: on a blade (a coronoid process) most of the area lies on its two faces, whose
+// rays cross it, while the rays of its rim run along it.
 double region_thickness(const SurfaceProjector& solid, const std::vector<int>& triangles) {
   const TriSurface& surface = solid.surface();
-  std::vector<double> depth;
+  std::vector<std::pair<double, double>> depth;  // (distance, triangle area)
   for (int t : triangles) {
     const auto& tri = surface.triangles[t];
     const Vec3& a = surface.vertices[tri[0]];
@@ -867,11 +868,20 @@ double region_thickness(const SurfaceProjector& solid, const std::vector<int>& t
     const double hair = 1e-6 * std::sqrt(len);
     SurfacePoint hit;
     if (solid.first_hit(add(c, scale(inward, hair)), inward, kInf, &hit))
-      depth.push_back(hit.distance + hair);
+      depth.emplace_back(hit.distance + hair, 0.5 * len);
   }
   if (depth.empty()) return 0.0;
-  std::nth_element(depth.begin(), depth.begin() + depth.size() / 2, depth.end());
-  return depth[depth.size() / 2];
+  // The median by area, not by triangle count: a thin plate's few long narrow side triangles (whose rays
+  // cross the whole plate) must not outvote its faces (a 1 mm plate of 100 x 100 mm was "100.0 mm thick").
+  std::sort(depth.begin(), depth.end());
+  double total = 0;
+  for (const auto& [d, area] : depth) total += area;
+  double below = 0;
+  for (const auto& [d, area] : depth) {
+    below += area;
+    if (below >= 0.5 * total) return d;
+  }
+  return depth.back().first;
 }
 
 // Surface regions farther than `limit` (half the mean edge) from the mesh boundary, grouped by shared

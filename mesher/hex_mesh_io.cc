@@ -39,6 +39,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The file name's extension in lower case (".vtu"), empty without one.
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
 // Shortest decimal text that reads back to the same double, so text files round-trip exactly.
 std::string format_double(double v) {
   char buf[32];
@@ -189,11 +196,18 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   const std::string where = "hex mesh '" + path + "'";
   vtkNew<vtkXMLUnstructuredGridReader> reader;
   VtkMessageCapture capture;
-  if (reader->CanReadFile(path.c_str()) == 0)
+  if (reader->CanReadFile(path.c_str()) == 0) {
+    // Any name but .msh comes here: for another extension (an Abaqus .inp, a surface) say what is read.
+    const std::string ext = lower_extension(path);
     throw InputError(
         "cannot read " + where +
         ": not a VTK XML unstructured grid (.vtu) file; expected a <VTKFile type=\"UnstructuredGrid\"> "
-        "document");
+        "document" +
+        (ext == ".vtu"
+             ? std::string()
+             : "; hex meshes are read from .vtu or Gmsh .msh (4.1 or 2.2 ASCII) files only: give one "
+               "(an .inp is written, not read; Gmsh converts other formats to .msh)"));
+  }
   reader->SetFileName(path.c_str());
   update_xml_reader(reader, path);
   vtkUnstructuredGrid* grid = reader->GetOutput();
@@ -554,17 +568,6 @@ HexMesh read_msh(const std::string& path) {
   check_mesh(mesh, "Gmsh mesh '" + path + "'");
   return mesh;
 }
-
-namespace {
-
-// The file name's extension in lower case (".vtu"), empty without one.
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
-
-}  // namespace
 
 void write_hex_mesh(const std::string& path, const HexMesh& mesh, const std::vector<MeshArray>& cell_arrays,
                     const std::vector<MeshArray>& point_arrays) {

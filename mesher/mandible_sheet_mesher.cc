@@ -89,6 +89,16 @@ HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* land
   MandibleSheetReport local;
   MandibleSheetReport& report = report_out ? *report_out : local;
   report = MandibleSheetReport{};
+  // The quad count follows from the hex count; past the template's 200,000 quads say so in the user's terms
+  // (before: "--target-quads 206362 is out of range", an option of another command that was never given).
+  if (const int q = quads_for_target_hexes(o.target_hexes); q > 200000) {
+    long most = o.target_hexes;
+    while (most > 8 && quads_for_target_hexes(most) > 200000) most = most * 99 / 100;
+    while (quads_for_target_hexes(most + 1) <= 200000) ++most;
+    throw InputError("--target-hexes " + std::to_string(o.target_hexes) + " asks for a quad surface of " +
+                     std::to_string(q) + " quads, more than the 200,000 of the mandible template: give at " +
+                     "most " + std::to_string(most) + " hexes with --method sheets, or use --method grid");
+  }
   const QuadSurface quads = checked_mandible_quads(surface, landmarks, quads_for_target_hexes(o.target_hexes),
                                                    o.surface_name, o.landmark_file, &report.quad,
                                                    &report.quad_check, o.refinement, &report.refinement);

@@ -3,6 +3,7 @@
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
@@ -179,12 +180,18 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
     render_actor_png(actor, nullptr, png_path, options);
     return;
   }
+  // A point array (a solution field such as von_mises), else a cell array (the per-hex quality arrays that
+  // hexbite mesh, refine and reorder write, such as scaled_jacobian): each hex's face in its colour.
   vtkDataArray* array = grid->GetPointData()->GetArray(field.c_str());
+  const bool per_cell = array == nullptr && grid->GetCellData()->GetArray(field.c_str()) != nullptr;
+  if (per_cell) array = grid->GetCellData()->GetArray(field.c_str());
   if (array == nullptr) {
     std::string names;
     for (int i = 0; i < grid->GetPointData()->GetNumberOfArrays(); ++i)
       names += std::string(names.empty() ? "" : ", ") + grid->GetPointData()->GetArrayName(i);
-    throw InputError("'" + vtu_path + "' has no point array '" + field +
+    for (int i = 0; i < grid->GetCellData()->GetNumberOfArrays(); ++i)
+      names += std::string(names.empty() ? "" : ", ") + grid->GetCellData()->GetArrayName(i) + " (per hex)";
+    throw InputError("'" + vtu_path + "' has no point or cell array '" + field +
                      "'; available: " + (names.empty() ? "none" : names));
   }
   const int component = array->GetNumberOfComponents() == 1 ? 0 : -1;  // -1: magnitude
@@ -197,7 +204,10 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
   colours->SetTableRange(range);
   colours->Build();
   mapper->SetLookupTable(colours);
-  mapper->SetScalarModeToUsePointFieldData();
+  if (per_cell)
+    mapper->SetScalarModeToUseCellFieldData();
+  else
+    mapper->SetScalarModeToUsePointFieldData();
   mapper->SelectColorArray(field.c_str());
   if (component < 0) colours->SetVectorModeToMagnitude();
   mapper->SetScalarRange(range);

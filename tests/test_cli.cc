@@ -303,6 +303,88 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
 }
 
+// Not-a-number and infinite values of real-valued options are input errors (exit 2) that give the range, and
+// nothing is written: `mesh --margin nan` crashed (segmentation fault; CLI::Range lets NaN through) and
+// `--refine-at nan,0,0` stopped on a floating-point exception.
+TEST(CliBadInput, NonFiniteNumbersAreRefused) {
+  const std::string dir = temp_dir();
+  const std::string cube = write_case("cube.obj", cube_obj());
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"mesh", cube, "--margin", "nan", "-o", dir + "/m.vtu"},
+       "--margin: nan is out of range: give a number from -0.8 to 2"},
+      {{"mesh", cube, "--margin", "-inf", "-o", dir + "/m.vtu"}, "--margin: -inf is out of range"},
+      {{"mesh", cube, "--margin", "0.1x", "-o", dir + "/m.vtu"}, "--margin: 0.1x is not a number"},
+      {{"quad", "from-mandible", cube, "--refine-at", "nan,0,0", "-o", dir + "/q.obj"},
+       "--refine-at 'nan,0,0' is not a point: X, Y and Z must be finite numbers in mm"},
+      {{"mesh", cube, "--method", "sheets", "--refine-at", "0,inf,0", "-o", dir + "/m.vtu"},
+       "--refine-at '0,inf,0' is not a point"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[2] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));  // no output and no temporary file
+}
+
+// A plate 1 mm thick and 40 x 40 mm across cannot be meshed with about 64 hexes (its cells reach across the
+// plate whatever their size): the mesh is written, and a warning says how far its count is from the target
+// (before: only "target 64" after the count, silently 5 times off). The JSON is unchanged and alone.
+TEST(Cli, HexCountFarFromTheTargetIsWarnedAbout) {
+  std::string plate;
+  for (int v = 0; v < 8; ++v)
+    plate += "v " + std::to_string(40 * (v & 1)) + " " + std::to_string(40 * ((v >> 1) & 1)) + " " +
+             std::to_string((v >> 2) & 1) + "\n";
+  for (const char* f : kCubeFaces) plate += f;
+  const std::string path = write_case("plate.obj", plate);
+  const std::string mesh = temp_dir() + "/plate.vtu";
+  auto r = run_hexbite({"mesh", path, "--target-hexes", "64", "-o", mesh, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const long hexes = j["hexes"];
+  EXPECT_GT(hexes, 2 * 64);
+  EXPECT_NE(r.err.find("hexbite: warning: the mesh has " + std::to_string(hexes) + " hexes, "),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(" times --target-hexes 64: no cell size tried came closer"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::exists(mesh));
+  // A mesh near its target (the unit cube at 100 hexes gets 81) has no such warning.
+  r = run_hexbite({"mesh", write_case("cube.obj", cube_obj()), "--target-hexes", "100", "-o", mesh});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
+// --method sheets turns --target-hexes into a quad count for the mandible template (at most 200,000 quads):
+// a count that asks for more is named as --target-hexes with the largest one that works, not as
+// "--target-quads 206362 is out of range" (an option of quad from-mandible that was never given).
+TEST(CliBadInput, SheetsTargetBeyondTheTemplateIsNamedInHexes) {
+  const std::string dir = temp_dir();
+  const std::string cube = write_case("cube.obj", cube_obj());
+  for (const std::string& target : {"5e6", "4770603"}) {
+    const auto r =
+        run_hexbite({"mesh", cube, "--method", "sheets", "--target-hexes", target, "-o", dir + "/m.vtu"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(
+        r.err.find("quads, more than the 200,000 of the mandible template: give at most 4770602 hexes with "
+                   "--method sheets, or use --method grid"),
+        std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("--target-quads"), std::string::npos) << r.err;
+  }
+  // One fewer is a count the template takes: the next check (this unit cube is no mandible) speaks.
+  const auto r =
+      run_hexbite({"mesh", cube, "--method", "sheets", "--target-hexes", "4770602", "-o", dir + "/m.vtu"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("the mandible template places on mandibles 30 to 300 mm across"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 // With --json, standard output is one JSON document, also without --quiet: `hexbite run ... --json | jq`
 // broke on the informational lines (the run's "not resolved: ..." parts) printed before the JSON. Every
 // command that has --json, on a small generated mandible and the shipped default scenario.

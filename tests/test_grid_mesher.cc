@@ -449,6 +449,21 @@ TEST(GridMesher, CutCornersOfAThickPartAreNotCalledThin) {
   }
 }
 
+// A plate 1 mm thick and 40 x 40 mm across, too thin for the cells of 64 hexes: the region is named as a part
+// about 1 mm thick. Its side faces hold twice as many triangles as its two large faces (long narrow ones
+// whose inward rays cross the whole plate), so a median by triangle count called it "40.0 mm thick"; the
+// median is by area.
+TEST(GridMesher, AThinPlateIsCalledThinWhateverItsTriangleCount) {
+  const Outcome o = run(box(40.0, 40.0, 1.0), 64);
+  expect_common(o);
+  ASSERT_FALSE(o.report.fidelity.unresolved.empty());
+  for (const UnresolvedPart& u : o.report.fidelity.unresolved) {
+    EXPECT_NEAR(u.thickness, 1.0, 1e-6) << u.what;
+    EXPECT_NE(u.what.find("a part about 1.0 mm thick, thinner than the mean edge"), std::string::npos)
+        << u.what;
+  }
+}
+
 // The built-in mandible (generate_mandible with its defaults) at 2,500 hexes. Met: 0 inverted, SJ min >= 0.3
 // (0.547), kappa max <= 10 (6.53), no part lost. NOT met, asserted at the measured level (measured: SJ mean
 // 0.792, volume -3.41 %, Hausdorff 0.64 mean edge lengths): mean >= 0.85, volume within 3 %, Hausdorff <=

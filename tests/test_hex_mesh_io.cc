@@ -545,10 +545,13 @@ TEST(QualityCommand, BadInputExitsTwo) {
   write_file(dir + "/garbage.vtu",
              "\x7f"
              "ELF garbage");
+  // An Abaqus deck (which hexbite writes but does not read): the message says which formats are read.
+  write_file(dir + "/deck.inp", "*NODE, NSET=NALL\n1, 0, 0, 0\n");
   const std::pair<std::string, std::string> cases[] = {
       {dir + "/missing.vtu", "does not exist"},
       {dir + "/tetra.vtu", "cell 0 is a vtkTetra"},
-      {dir + "/garbage.vtu", "not a VTK XML unstructured grid"}};
+      {dir + "/garbage.vtu", "not a VTK XML unstructured grid"},
+      {dir + "/deck.inp", "hex meshes are read from .vtu or Gmsh .msh (4.1 or 2.2 ASCII) files only"}};
   for (const auto& [path, expected] : cases) {
     const test::CommandResult r = run_hexbite({"quality", path});
     EXPECT_EQ(r.exit_code, 2) << path;

@@ -2,6 +2,7 @@
 // 3-connected, chords) and `hexbite quad check`.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "common/error.h"
@@ -344,6 +345,22 @@ TEST(QuadFromMeshCli, BoundaryOfABlock) {
   EXPECT_NEAR(six_volume / 6.0, 24.0, 1e-9);
   const auto bad = test::run_hexbite({"quad", "from-mesh", dir + "/block.msh", "-o", dir + "/q.vtu"});
   EXPECT_EQ(bad.exit_code, 2);
+}
+
+// A mesh with inverted hexes has inward faces (a mirrored block: all of them), so `quad from-mesh` would
+// write an inward surface while saying "outward": refused as bad input (exit 2), the hexes named with their
+// centroids, nothing written; as hexbite refine refuses it.
+TEST(QuadFromMeshCli, InvertedHexesAreRefused) {
+  const std::string dir = test::temp_dir();
+  HexMesh mirrored = make_block_mesh(2, 1, 1);
+  for (Vec3& v : mirrored.vertices) v[2] = -v[2];
+  write_msh(dir + "/mirrored.msh", mirrored);
+  const auto r = test::run_hexbite({"quad", "from-mesh", dir + "/mirrored.msh", "-o", dir + "/q.obj"});
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.err.find("has 2 inverted hexes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("hex 0 at (0.50, 0.50, -0.50) mm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nothing written"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/q.obj"));
 }
 
 }  // namespace

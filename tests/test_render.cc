@@ -62,9 +62,21 @@ TEST(Render, SurfaceAndSolutionFieldPictures) {
                             "render '" + dir + "/jaw.vtu' --field no_such_field -o '" + dir + "/f.png'",
                             dir + "/log2"),
             2);
-  EXPECT_NE(read_file(dir + "/log2").find("no point array 'no_such_field'"), std::string::npos)
+  EXPECT_NE(read_file(dir + "/log2")
+                .find("no point or cell array 'no_such_field'; available: scaled_jacobian (per "
+                      "hex), condition (per hex)"),
+            std::string::npos)
       << read_file(dir + "/log2");
   EXPECT_FALSE(fs::exists(dir + "/f.png"));
+  // The per-hex quality arrays that hexbite mesh writes colour the picture too (before: "no point array
+  // 'scaled_jacobian'; available: none").
+  EXPECT_EQ(run_with_prefix(display_prefix(),
+                            "render '" + dir + "/jaw.vtu' --field scaled_jacobian -o '" + dir +
+                                "/sj.png' --width 320 --height 200",
+                            dir + "/log3"),
+            0)
+      << read_file(dir + "/log3");
+  EXPECT_EQ(png_size(read_file(dir + "/sj.png")), std::make_pair(320, 200));
 }
 
 // A cut-off VTU: one error line with VTK's explanation in it, not VTK's own coloured multi-line log.
