@@ -128,7 +128,8 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
       << " mm^3, difference " << fmt("%+.2f", 100.0 * f.volume_difference) << " %\n";
   if (r.volume_fit) out << "volume fit: " << describe(*r.volume_fit) << '\n';
   if (!f.unresolved.empty()) {
-    out << "not resolved at this size (" << f.unresolved.size() << " regions):\n";
+    out << "not resolved at this size (" << f.unresolved.size()
+        << (f.unresolved.size() == 1 ? " region):\n" : " regions):\n");
     for (const std::string& line : unresolved_listing(f.unresolved)) out << "  " << line << '\n';
   }
   return out.str();

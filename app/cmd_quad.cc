@@ -179,8 +179,9 @@ void run_quad_from_mesh(const QuadFromMeshOptions& o) {
     return;
   }
   info("Boundary of " + o.mesh + " (" + std::to_string(mesh.hexes.size()) +
-       " hexes): " + std::to_string(boundary.surface.quads.size()) + " quads, " +
-       std::to_string(boundary.surface.vertices.size()) + " vertices, outward\nwrote " + o.output);
+       (mesh.hexes.size() == 1 ? " hex): " : " hexes): ") + std::to_string(boundary.surface.quads.size()) +
+       " quads, " + std::to_string(boundary.surface.vertices.size()) + " vertices, outward\nwrote " +
+       o.output);
 }
 
 }  // namespace
