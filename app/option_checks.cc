@@ -31,6 +31,21 @@ std::string listed(const std::vector<std::string>& extensions) {
   return text;
 }
 
+// Why `value` is not a finite number in [lo, hi] (ending in `give`, what to give instead), or empty with the
+// number in `number`. NaN and infinities are out of range (CLI::Range lets NaN through).
+std::string out_of_range(const std::string& value, double lo, double hi, const std::string& give,
+                         double* number) {
+  std::size_t used = 0;
+  try {
+    *number = std::stod(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != value.size()) return value + " is not a number: " + give;
+  if (!std::isfinite(*number) || *number < lo || *number > hi) return value + " is out of range: " + give;
+  return {};
+}
+
 }  // namespace
 
 CLI::Validator count_in_range(long lo, long hi) {
@@ -38,15 +53,8 @@ CLI::Validator count_in_range(long lo, long hi) {
   return CLI::Validator(
       [lo, hi, range](std::string& value) -> std::string {
         double number = 0;
-        std::size_t used = 0;
-        try {
-          number = std::stod(value, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used == 0 || used != value.size()) return value + " is not a number: " + range;
-        if (!std::isfinite(number) || number < static_cast<double>(lo) || number > static_cast<double>(hi))
-          return value + " is out of range: " + range;
+        const std::string error = out_of_range(value, double(lo), double(hi), range, &number);
+        if (!error.empty()) return error;
         if (number != std::floor(number)) return value + " is not a whole number: " + range;
         value = std::to_string(static_cast<long>(number));
         return {};
@@ -59,15 +67,7 @@ CLI::Validator number_in_range(double lo, double hi, const std::string& range) {
   return CLI::Validator(
       [lo, hi, give](std::string& value) -> std::string {
         double number = 0;
-        std::size_t used = 0;
-        try {
-          number = std::stod(value, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used == 0 || used != value.size()) return value + " is not a number: " + give;
-        if (!std::isfinite(number) || number < lo || number > hi) return value + " is out of range: " + give;
-        return {};
+        return out_of_range(value, lo, hi, give, &number);
       },
       "");
 }
