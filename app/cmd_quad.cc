@@ -15,13 +15,13 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_inputs.h"
 #include "app/mesh_sheets_surface.h"
 #include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
-#include "mesher/hex_quality.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_surface_io.h"
 
@@ -151,21 +151,8 @@ void run_quad_from_mesh(const QuadFromMeshOptions& o) {
   const HexMesh mesh = read_hex_mesh(o.mesh);
   // An inverted hex's faces point inward, so its boundary quads would not be the outward surface claimed
   // here (a mirrored mesh gives a wholly inward one): refused as bad input, as hexbite refine does.
-  const HexQualityField field = compute_hex_quality(mesh);
-  std::vector<int> inverted;
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-    if (!(field.jacobian[h] > 0.0)) inverted.push_back(static_cast<int>(h));  // NaN counts as inverted
-  if (!inverted.empty()) {
-    const std::string count = std::to_string(inverted.size());
-    throw InputError("'" + o.mesh + "' has " + count + " inverted " +
-                     (inverted.size() == 1 ? "hex" : "hexes") +
-                     " (a corner Jacobian <= 0), whose faces point inward, so its boundary is not an outward "
-                     "quad surface: " +
-                     hex_list_text(mesh, inverted, 5) +
-                     "; nothing written: re-mesh the surface (hexbite mesh), or find the worst hexes with "
-                     "hexbite quality " +
-                     o.mesh + " --worst " + count);
-  }
+  require_no_inverted_hexes(mesh, o.mesh,
+                            "whose faces point inward, so its boundary is not an outward quad surface");
   const HexBoundary boundary = extract_boundary(mesh);
   write_quad_obj(o.output, boundary.surface);
   if (o.json) {

@@ -187,23 +187,6 @@ void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surf
   throw InputError(text.str());
 }
 
-// Every child of an inverted hex is inverted too, so refining an inverted mesh can only fail at the end; it
-// is refused up front as bad input, naming the hexes and where they are.
-void require_no_inverted_hexes(const HexMesh& coarse, const RefineCliOptions& o) {
-  const HexQualityField field = compute_hex_quality(coarse);
-  std::vector<int> inverted;
-  for (std::size_t h = 0; h < coarse.hexes.size(); ++h)
-    if (!(field.jacobian[h] > 0.0)) inverted.push_back(static_cast<int>(h));  // NaN counts as inverted
-  if (inverted.empty()) return;
-  const std::string count = std::to_string(inverted.size());
-  throw InputError(
-      "'" + o.mesh + "' has " + count + " inverted " + (inverted.size() == 1 ? "hex" : "hexes") +
-      " (a corner Jacobian <= 0), which refinement cannot repair: " + hex_list_text(coarse, inverted, 5) +
-      "; nothing written: re-mesh the surface (hexbite mesh), or find the worst hexes with "
-      "hexbite quality " +
-      o.mesh + " --worst " + count);
-}
-
 void run_refine(const RefineCliOptions& o) {
   if (o.fit_volume && o.surface.empty())
     throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
@@ -214,7 +197,8 @@ void run_refine(const RefineCliOptions& o) {
                      std::to_string(coarse.hexes.size()) + " hexes of " + o.mesh + " into " +
                      std::to_string(refined) + " hexes, more than " + std::to_string(kMaxRefinedHexes) +
                      "; use fewer levels");
-  require_no_inverted_hexes(coarse, o);
+  // Every child of an inverted hex is inverted too, so refining an inverted mesh can only fail at the end.
+  require_no_inverted_hexes(coarse, o.mesh, "which refinement cannot repair");
   std::unique_ptr<SurfaceProjector> projector;
   if (!o.surface.empty()) {
     projector = std::make_unique<SurfaceProjector>(load_surface_input(o.surface, o.units));

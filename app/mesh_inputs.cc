@@ -1,7 +1,11 @@
 #include "app/mesh_inputs.h"
 
 #include <iostream>
+#include <string>
+#include <vector>
 
+#include "common/error.h"
+#include "mesher/hex_quality.h"
 #include "mesher/surface_check.h"
 #include "mesher/units.h"
 
@@ -26,6 +30,20 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
   const std::string fit_warning = landmark_fit_warning(*in.landmarks, in.surface, landmark_file);
   if (!fit_warning.empty()) std::cerr << "hexbite: warning: " << fit_warning << ".\n";
   return in;
+}
+
+void require_no_inverted_hexes(const HexMesh& mesh, const std::string& path, const std::string& why) {
+  const HexQualityField field = compute_hex_quality(mesh);
+  std::vector<int> inverted;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    if (!(field.jacobian[h] > 0.0)) inverted.push_back(static_cast<int>(h));  // NaN counts as inverted
+  if (inverted.empty()) return;
+  const std::string count = std::to_string(inverted.size());
+  throw InputError("'" + path + "' has " + count + " inverted " + (inverted.size() == 1 ? "hex" : "hexes") +
+                   " (a corner Jacobian <= 0), " + why + ": " + hex_list_text(mesh, inverted, 5) +
+                   "; nothing written: re-mesh the surface (hexbite mesh), or find the worst hexes with "
+                   "hexbite quality " +
+                   path + " --worst " + count);
 }
 
 }  // namespace hexbite

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "mesher/hex_mesh.h"
 #include "mesher/landmarks.h"
 #include "mesher/tri_surface.h"
 
@@ -25,5 +26,10 @@ TriSurface load_surface_input(const std::string& surface_file, const std::string
 // `units`: the unit of both files (mm, cm or m); `landmark_file` empty: no landmarks.
 MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& units,
                             const std::string& landmark_file);
+
+// For the commands that read a hex mesh and cannot work on an inverted one (`refine`, `quad from-mesh`):
+// throws an InputError naming the inverted hexes of `mesh` (read from `path`; a corner Jacobian <= 0 or NaN)
+// with their centroids, `why` they are refused, and what to do.
+void require_no_inverted_hexes(const HexMesh& mesh, const std::string& path, const std::string& why);
 
 }  // namespace hexbite
