@@ -334,6 +334,15 @@ json results_json(const RunResult& r, double seconds_output) {
                         {"patch_area_mm2", coarse.support_patches[i].area_mm2},
                         {"facets", coarse.support_patches[i].faces.size()}});
   j["supports"] = supports;
+  json hold = json::array();
+  for (const RigidMode& m : r.support_hold) {
+    json body = {{"hold", m.rho}, {"weak", is_weak(m)}};
+    body["weakest_motion"] = m.rotation ? "rotation" : "translation";
+    body["direction"] = vec(m.direction);
+    if (m.rotation) body["axis_point_mm"] = vec(m.axis_point);
+    hold.push_back(body);
+  }
+  j["support_hold"] = hold;
   json levels = json::array();
   for (const LevelResult& l : r.levels) levels.push_back(level_figures(s, l));
   j["validation"] = {{"levels", levels},

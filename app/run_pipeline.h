@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "app/rigid_support.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_quality.h"
@@ -50,6 +51,8 @@ struct RunResult {
   std::string
       mesh_core;  // method grid: the core the coarse mesh has, "grid" or "swept" (mesh.core auto picks)
   std::vector<LevelResult> levels;
+  std::vector<RigidMode>
+      support_hold;  // per body of the coarse mesh: the rigid motion its supports hold least
   double seconds_geometry = 0.0;
   double seconds_total = 0.0;
 };

@@ -1028,33 +1028,38 @@ void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPar
   }
 }
 
-double hex_mesh_volume(const HexMesh& mesh) {
+double hex_volume(const HexMesh& mesh, int hex) {
   // Reference coordinates of the VTK hexahedron's nodes.
   static const double ref[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
   const double gp[2] = {0.5 - 0.5 / std::sqrt(3.0), 0.5 + 0.5 / std::sqrt(3.0)};
+  const auto& h = mesh.hexes[hex];
   double volume = 0;
-  for (const auto& h : mesh.hexes) {
-    for (int q = 0; q < 8; ++q) {
-      const double xi[3] = {gp[q & 1], gp[q >> 1 & 1], gp[q >> 2 & 1]};
-      double j[3][3] = {};
-      for (int n = 0; n < 8; ++n) {
-        double dn[3];
-        for (int a = 0; a < 3; ++a) {
-          dn[a] = ref[n][a] ? 1.0 : -1.0;
-          for (int b = 0; b < 3; ++b)
-            if (b != a) dn[a] *= ref[n][b] ? xi[b] : 1.0 - xi[b];
-        }
-        const Vec3& x = mesh.vertices[h[n]];
-        for (int r = 0; r < 3; ++r)
-          for (int a = 0; a < 3; ++a) j[r][a] += x[r] * dn[a];
+  for (int q = 0; q < 8; ++q) {
+    const double xi[3] = {gp[q & 1], gp[q >> 1 & 1], gp[q >> 2 & 1]};
+    double j[3][3] = {};
+    for (int n = 0; n < 8; ++n) {
+      double dn[3];
+      for (int a = 0; a < 3; ++a) {
+        dn[a] = ref[n][a] ? 1.0 : -1.0;
+        for (int b = 0; b < 3; ++b)
+          if (b != a) dn[a] *= ref[n][b] ? xi[b] : 1.0 - xi[b];
       }
-      const double det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) -
-                         j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0]) +
-                         j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
-      volume += det / 8.0;
+      const Vec3& x = mesh.vertices[h[n]];
+      for (int r = 0; r < 3; ++r)
+        for (int a = 0; a < 3; ++a) j[r][a] += x[r] * dn[a];
     }
+    const double det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1]) -
+                       j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0]) +
+                       j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+    volume += det / 8.0;
   }
+  return volume;
+}
+
+double hex_mesh_volume(const HexMesh& mesh) {
+  double volume = 0;
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) volume += hex_volume(mesh, static_cast<int>(h));
   return volume;
 }
 

@@ -236,7 +236,8 @@ void name_unresolved_parts(const Landmarks& landmarks, std::vector<UnresolvedPar
 // smaller regions". The full list is in the commands' JSON.
 std::vector<std::string> unresolved_listing(const std::vector<UnresolvedPart>& parts, std::size_t shown = 10);
 
-// Volume of a hex mesh with trilinear hexes (2 x 2 x 2 Gauss points, exact for trilinear maps).
+// Volume of a trilinear hex, and of a hex mesh (2 x 2 x 2 Gauss points, exact for trilinear maps).
+double hex_volume(const HexMesh& mesh, int hex);
 double hex_mesh_volume(const HexMesh& mesh);
 
 // Geometric fidelity of a hex mesh against the surface it should fill.
