@@ -2,7 +2,8 @@
 //
 // The whole simulation: geometry, hex mesh, solve, validation levels (refined 8-way and solved again), then
 // DIR/results.json, DIR/mesh.vtu, DIR/solution*.vtu (or .pvtu under mpirun) and, with --export inp,
-// DIR/model.inp for CalculiX. A scenario error (exit 2) is found before anything is solved or written. The
+// DIR/model.inp for CalculiX. A scenario error (exit 2) is found before anything is solved or written; a
+// failure while writing (exit 1) leaves DIR as it was, the set is moved in only when complete. The
 // equilibrium residual of every level is checked after the results are written: above
 // kEquilibriumTolerance the run fails (exit 1), so a wrong answer never passes silently but stays
 // inspectable. Under mpirun every rank runs this command; rank 0 prints and writes (docs/running.md).
@@ -20,7 +21,6 @@
 #include "app/option_checks.h"
 #include "app/run_outputs.h"
 #include "app/run_pipeline.h"
-#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/tri_surface.h"
@@ -58,12 +58,14 @@ void run_run(const RunCliOptions& o) {
 
   const RunResult result = run_pipeline(std::move(scenario), levels);
 
+  // All or nothing: a failure while writing leaves o.output as it was (app/run_outputs.h).
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<std::string> files = write_run_outputs(result, o.output, export_inp);
+  RunOutputs outputs(o.output);
+  const std::vector<std::string> files = outputs.write(result, export_inp);
   const double seconds_output =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const nlohmann::json results = results_json(result, seconds_output);
-  if (root) write_file_atomically(o.output + "/results.json", results.dump(2) + '\n');
+  outputs.commit(results.dump(2) + '\n');
 
   if (root && o.json) {
     std::cout << results.dump(2) << '\n';

@@ -6,7 +6,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -22,7 +21,6 @@ namespace hexbite {
 
 namespace {
 
-namespace fs = std::filesystem;
 using nlohmann::json;
 
 json vec(const Vec3& v) {
@@ -365,58 +363,133 @@ json results_json(const RunResult& r, double seconds_output) {
 
 namespace {
 
-// The files of an earlier run into the same folder that this run does not rewrite (the
-// solution_level2.vtu of a run with more levels, a model.inp of a run with --export inp, the pieces of
-// another rank count) would pass for this run's: they are removed. Other files are left alone.
-void remove_stale_outputs(const std::string& dir, const std::vector<std::string>& written) {
+// The names of the files a run may write but results.json (which every run writes): those of an earlier run
+// into the same folder that this run does not rewrite are removed when this run's set is moved in.
+bool is_output_name(const std::string& name) {
   static const std::regex kOutputName(
       R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    if (!std::regex_match(name, kOutputName) ||
-        std::find(written.begin(), written.end(), name) != written.end())
-      continue;
-    std::error_code ec;
-    fs::remove(entry.path(), ec);
-    if (ec)
-      throw RunError("cannot remove " + entry.path().string() +
-                     ", left by an earlier run and not rewritten " + "by this one: " + ec.message() +
-                     "; remove it or choose another output folder");
-  }
+  return std::regex_match(name, kOutputName);
+}
+
+void broadcast(std::string* text, int root) {
+  unsigned long size = text->size();
+  MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG, root, MPI_COMM_WORLD);
+  text->resize(size);
+  MPI_Bcast(text->data(), static_cast<int>(size), MPI_CHAR, root, MPI_COMM_WORLD);
+}
+
+// `text` with every `from` replaced by `to`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  if (from.empty()) return text;
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
 }
 
 }  // namespace
 
-std::vector<std::string> write_run_outputs(const RunResult& r, const std::string& dir, bool export_inp) {
+RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
+  while (dir_.size() > 1 && dir_.back() == '/') dir_.pop_back();  // as OutputStage names it
+  const bool root = MpiSession::rank() == 0;
+  on_all_ranks(
+      [&] {
+        if (!root) return;
+        stage_ = std::make_unique<OutputStage>(dir);
+        stage_dir_ = stage_->stage_dir();
+        created_dir_ = stage_->created_dir();
+      },
+      kNoNote);
+  // The pieces of a distributed run are written into the stage that rank 0 just made.
+  if (MpiSession::size() > 1) {
+    broadcast(&stage_dir_, 0);
+    int created = created_dir_;
+    MPI_Bcast(&created, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    created_dir_ = created != 0;
+  }
+}
+
+RunOutputs::~RunOutputs() = default;  // ~OutputStage discards an uncommitted stage
+
+// Under mpirun an error of one rank (its piece did not fit on the disk) used to leave the others waiting in
+// the next collective call until the job was aborted, with no rank left to clean up. Here every rank runs
+// its part of `step`, then all learn whether any rank failed and throw the error of the lowest rank that
+// did (the same text everywhere, so rank 0 alone prints it), after which rank 0 discards the stage: by then
+// no rank writes into it any more. A writer's message names the file by its place in DIR, not in the stage.
+void RunOutputs::on_all_ranks(const std::function<void()>& step, Note note) {
+  int kind = 0;  // 0 done, 1 RunError (or another failure), 2 InputError
+  std::string message;
+  try {
+    step();
+  } catch (const InputError& e) {
+    kind = 2;
+    message = e.what();
+  } catch (const std::exception& e) {
+    kind = 1;
+    message = e.what();
+  }
+  const int ranks = MpiSession::size();
+  if (ranks > 1) {
+    const int mine = kind != 0 ? MpiSession::rank() : ranks;
+    int first = ranks;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first == ranks) return;
+    MPI_Bcast(&kind, 1, MPI_INT, first, MPI_COMM_WORLD);
+    broadcast(&message, first);
+  }
+  if (kind == 0) return;
+  message = replaced(message, stage_dir_, dir_);
+  if (note != kNoNote)
+    message +=
+        "; the run kept none of its files and " +
+        (created_dir_ ? "did not create '" + dir_ + "'" : "left '" + dir_ + "' as it was") +
+        (note == kWriteNote ? ": make room on the disk or choose another output folder, and run again" : "");
+  if (kind == 2) throw InputError(message);
+  throw RunError(message);
+}
+
+std::vector<std::string> RunOutputs::write(const RunResult& r, bool export_inp) {
   const bool vtu = r.scenario.outputs.vtu;
   const int rank = MpiSession::rank();
   std::vector<std::string> written;
-  if (rank == 0) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw RunError("cannot create the output folder '" + dir + "': " + ec.message());
-  }
-  // The pieces of a distributed run are written into the folder rank 0 just created.
-  MPI_Barrier(MPI_COMM_WORLD);
-  if (rank == 0) {
-    if (vtu) {
-      write_vtu(dir + "/mesh.vtu", r.levels.front().mesh);
-      written.push_back("mesh.vtu");
-    }
-    if (export_inp) {
-      write_inp_deck(r, dir);
-      written.insert(written.end(), {"model.inp", "model_mesh.inp"});
-    }
-  }
-  for (const LevelResult& l : r.levels) {
-    if (!vtu) break;
-    const std::string stem = l.level == 0 ? "solution" : "solution_level" + std::to_string(l.level);
-    const std::vector<std::string> files = write_solution(l, dir, stem);
-    written.insert(written.end(), files.begin(), files.end());
-  }
-  MPI_Barrier(MPI_COMM_WORLD);
-  if (rank == 0) remove_stale_outputs(dir, written);
+  on_all_ranks(
+      [&] {
+        if (rank == 0) {
+          if (vtu) {
+            write_vtu(stage_dir_ + "/mesh.vtu", r.levels.front().mesh);
+            written.push_back("mesh.vtu");
+          }
+          if (export_inp) {
+            write_inp_deck(r, stage_dir_);
+            written.insert(written.end(), {"model.inp", "model_mesh.inp"});
+          }
+        }
+        for (const LevelResult& l : r.levels) {
+          if (!vtu) break;
+          const std::string stem = l.level == 0 ? "solution" : "solution_level" + std::to_string(l.level);
+          const std::vector<std::string> files = write_solution(l, stage_dir_, stem);
+          written.insert(written.end(), files.begin(), files.end());
+        }
+      },
+      kWriteNote);
+  files_ = written;
   return written;
+}
+
+void RunOutputs::commit(const std::string& results_text) {
+  const bool root = MpiSession::rank() == 0;
+  on_all_ranks(
+      [&] {
+        if (root) write_file_atomically(stage_dir_ + "/results.json", results_text);
+      },
+      kWriteNote);
+  on_all_ranks(
+      [&] {
+        if (!root) return;
+        std::vector<std::string> files = files_;
+        files.push_back("results.json");  // last: a script that waits for it finds the whole set
+        stage_->commit(files, is_output_name);
+      },
+      kCommitNote);
 }
 
 std::string summary_table(const RunResult& r) {

@@ -1,17 +1,21 @@
 // What `hexbite run` writes and prints from a RunResult: results.json (the contract documented in
 // docs/running.md), the VTU files of the mesh and the solution, the CalculiX deck, and the summary table.
 //
-// MPI: write_run_outputs() is collective. Rank 0 writes results.json, mesh.vtu and model.inp; the solution
-// of each level is written by rank 0 as one .vtu in a serial run, and under mpirun -np N (N > 1) as a
-// .pvtu whose N pieces are written by the ranks in parallel (each a contiguous block of hexes).
-// All files are written atomically (a failed run leaves no half-written file) and deterministically apart
-// from the timings in results.json.
+// MPI: RunOutputs is collective. Rank 0 writes results.json, mesh.vtu and model.inp; the solution of each
+// level is written by rank 0 as one .vtu in a serial run, and under mpirun -np N (N > 1) as a .pvtu whose N
+// pieces are written by the ranks in parallel (each a contiguous block of hexes).
+// The set is written all-or-nothing (common/output_stage.h): a failed run leaves the output folder as it
+// was. The files are deterministic apart from the timings in results.json.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "app/run_pipeline.h"
+#include "common/output_stage.h"
 
 namespace hexbite {
 
@@ -21,10 +25,42 @@ void check_inp_exportable(const Scenario& scenario);
 // results.json. `seconds_output` is the time spent writing the files (reported under seconds.output).
 nlohmann::json results_json(const RunResult& result, double seconds_output);
 
-// Writes DIR/mesh.vtu and the solution files of every level (unless the scenario's outputs.vtu is false)
-// and, with `export_inp`, DIR/model.inp with DIR/model_mesh.inp. Creates DIR. Returns the names of the files
-// written (relative to DIR).
-std::vector<std::string> write_run_outputs(const RunResult& result, const std::string& dir, bool export_inp);
+// The files of a run into DIR, all or nothing. Every rank constructs one and calls write() and commit()
+// together. An error of any rank (disk full, a folder in the way of a file name) makes every rank throw
+// the same error (RunError), so that rank 0 reports it once; the files of this run are then removed, and
+// DIR keeps the files of an earlier run untouched (or is not created, if it did not exist).
+class RunOutputs {
+ public:
+  // Creates DIR if it is missing, and the hidden folder the files are written into until commit().
+  explicit RunOutputs(const std::string& dir);
+  // Removes what commit() did not move into DIR.
+  ~RunOutputs();
+  RunOutputs(const RunOutputs&) = delete;
+  RunOutputs& operator=(const RunOutputs&) = delete;
+
+  // Writes mesh.vtu and the solution files of every level (unless the scenario's outputs.vtu is false)
+  // and, with `export_inp`, model.inp with model_mesh.inp. Returns the names of the files (relative to DIR;
+  // rank 0's view, with every rank's pieces).
+  std::vector<std::string> write(const RunResult& result, bool export_inp);
+
+  // Writes results.json with `results_text` and moves the whole set into DIR, results.json last. The files
+  // of an earlier run into DIR that this run does not rewrite (a solution_level2.vtu of a run with more
+  // levels, a model.inp of a run with --export inp, the pieces of another number of ranks) are removed with
+  // it, so that they cannot pass for this run's; other files are left alone.
+  void commit(const std::string& results_text);
+
+ private:
+  // Runs `step`, then every rank learns whether any failed and throws the same error (see the .cc), with
+  // what became of DIR (kWriteNote also says what to do).
+  enum Note { kNoNote, kWriteNote, kCommitNote };
+  void on_all_ranks(const std::function<void()>& step, Note note);
+
+  std::string dir_;
+  std::string stage_dir_;
+  bool created_dir_ = false;
+  std::unique_ptr<OutputStage> stage_;  // rank 0's
+  std::vector<std::string> files_;
+};
 
 // The table printed at the end of a run: per level bite force, reactions, maximum displacement, von Mises
 // maximum and 99th percentile, strain energy, solver figures, and the relative change of the last level.

@@ -34,7 +34,8 @@ void write_atomically(const std::string& final_path, const std::function<void(co
   std::error_code ec;
   fs::rename(tmp, target, ec);
   if (ec) {
-    fs::remove(tmp, ec);
+    std::error_code ignored;  // not ec: the message said "Success", the outcome of this remove
+    fs::remove(tmp, ignored);
     throw RunError("cannot write '" + final_path + "': " + ec.message());
   }
 }

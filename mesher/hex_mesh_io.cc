@@ -174,20 +174,21 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
   for (const MeshArray& a : point_arrays)
     grid->GetPointData()->AddArray(make_vtk_array(a.name, a.components, a.values));
 
-  write_atomically(path, [&](const std::string& tmp) {
-    vtkNew<vtkXMLUnstructuredGridWriter> writer;
-    writer->SetFileName(tmp.c_str());
-    writer->SetInputData(grid);
-    writer->SetDataModeToAppended();
-    writer->EncodeAppendedDataOff();
-    writer->SetCompressorTypeToZLib();
-    writer->SetHeaderTypeToUInt64();
-    writer->SetIdTypeToInt64();
-    VtkMessageCapture capture;
-    if (writer->Write() != 1 || !capture.errors().empty())
-      throw RunError("cannot write '" + path + "': " +
-                     (capture.errors().empty() ? std::string("VTK writer failed") : capture.errors()));
-  });
+  // Into memory first, then written and checked like every other file: VTK writing to the file itself did
+  // not notice a write that failed (a full disk, a file size limit), and left a truncated file with exit 0.
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->WriteToOutputStringOn();
+  writer->SetInputData(grid);
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToZLib();
+  writer->SetHeaderTypeToUInt64();
+  writer->SetIdTypeToInt64();
+  VtkMessageCapture capture;
+  if (writer->Write() != 1 || !capture.errors().empty())
+    throw RunError("cannot write '" + path +
+                   "': " + (capture.errors().empty() ? std::string("VTK writer failed") : capture.errors()));
+  write_file_atomically(path, writer->GetOutputString());
 }
 
 HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,

@@ -713,6 +713,74 @@ TEST(RunScenario, FilesOfAnEarlierRunThatThisRunDoesNotWriteAreRemoved) {
     EXPECT_TRUE(fs::exists(out + "/" + name)) << name;
 }
 
+// A run whose set could not be completed used to leave its files written so far beside those of the earlier
+// run in the folder: here model.inp of this run (another Young's modulus) beside the earlier run's
+// results.json and solution. The set now moves in whole or not at all.
+TEST(RunScenario, AFolderInTheWayOfAnOutputLeavesTheEarlierRunUntouched) {
+  const std::string dir = test::temp_dir();
+  const std::string out = dir + "/out";
+  test::write_file(dir + "/small.yaml", kSmall);
+  ASSERT_TRUE(run_scenario(dir + "/small.yaml", out, {"--export", "inp"}).is_object());
+  // A folder (the user's) where this run's solution.vtu goes.
+  fs::remove(out + "/solution.vtu");
+  fs::create_directories(out + "/solution.vtu/mine");
+  test::write_file(out + "/notes.txt", "mine\n");
+  const std::map<std::string, std::string> before = test::files_under(out);
+  test::write_file(dir + "/stiff.yaml", kSmall + "materials:\n  default: {E_MPa: 15000}\n");
+  const test::CommandResult r =
+      test::run_hexbite({"-q", "run", dir + "/stiff.yaml", "-o", out, "--export", "inp"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("hexbite: failed: cannot write '" + out +
+                       "/solution.vtu': a folder of that name is in the way; remove or rename it, or choose "
+                       "another output folder; the run kept none of its files and left '" +
+                       out + "' as it was\n"),
+            std::string::npos)
+      << r.err;
+  test::expect_same_files(before, test::files_under(out));  // byte for byte, and no temporary left
+}
+
+// A write that fails (a full disk; here a file size limit of 500 kB, which mesh.vtu, 0.3 MB, passes and
+// solution.vtu, 0.8 MB, does not) used to go unnoticed by the VTK writer: a truncated solution.vtu, the
+// new results.json, exit 0. It now fails the run, which keeps the earlier run's files or, into a folder
+// that did not exist, leaves no folder.
+TEST(RunScenario, AWriteThatFailsLeavesTheEarlierRunUntouchedAndCreatesNoFolder) {
+  const std::string dir = test::temp_dir();
+  const std::string out = dir + "/out";
+  test::write_file(dir + "/small.yaml", kSmall);
+  ASSERT_TRUE(run_scenario(dir + "/small.yaml", out).is_object());
+  const std::map<std::string, std::string> before = test::files_under(out);
+  ASSERT_GT(before.at("solution.vtu").size(), 600000u);
+  ASSERT_LT(before.at("mesh.vtu").size(), 400000u);
+  // SIGXFSZ ignored, so that a write beyond the limit fails with EFBIG as on a full disk. MPI's start-up
+  // (a singleton) keeps its shared memory stores within the limit with these two settings.
+  const std::vector<std::string> limited = {"env",
+                                            "PMIX_MCA_gds=hash",
+                                            "OMPI_MCA_btl=self",
+                                            "bash",
+                                            "-c",
+                                            "trap '' XFSZ; ulimit -f 500; exec \"$@\"",
+                                            "bash"};
+  test::write_file(dir + "/stiff.yaml", kSmall + "materials:\n  default: {E_MPa: 15000}\n");
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/stiff.yaml", "-o", out}, limited);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(
+                "hexbite: failed: cannot write '" + out +
+                "/solution.vtu': disk full or not writable; the run kept none of its files and left '" + out +
+                "' as it was: make room on the disk or choose another output folder, and run "
+                "again\n"),
+            std::string::npos)
+      << r.err;
+  test::expect_same_files(before, test::files_under(out));
+
+  const std::string fresh = dir + "/new/out";
+  const test::CommandResult n = test::run_hexbite({"-q", "run", dir + "/stiff.yaml", "-o", fresh}, limited);
+  EXPECT_EQ(n.exit_code, 1) << n.err;
+  EXPECT_NE(n.err.find("the run kept none of its files and did not create '" + fresh + "'"),
+            std::string::npos)
+      << n.err;
+  EXPECT_FALSE(fs::exists(dir + "/new"));
+}
+
 // E_MPa: 1e-6 (a unit slip) gave displacements of 1e15 mm with exit 0: linear elasticity holds only for
 // small displacements, so the run fails like an unbalanced one, its files kept for inspection.
 TEST(RunScenario, DisplacementsLargeAgainstTheBoneFailTheRun) {

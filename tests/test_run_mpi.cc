@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -21,6 +23,7 @@
 namespace hexbite {
 namespace {
 
+namespace fs = std::filesystem;
 using nlohmann::json;
 
 const std::string kDir = HEXBITE_RUN_MPI_DIR;
@@ -71,7 +74,8 @@ TEST(RunMpi, AScenarioErrorIsReportedOnce) {
 }
 
 // An error of rank 0 alone (its output folder cannot be made) left rank 1 waiting in a barrier, and the job
-// hung: the failing rank now aborts the job.
+// hung (then, for a while, the failing rank aborted the job). Every rank now learns of it and stops with
+// the same message, which rank 0 prints once.
 TEST(RunMpi, AnErrorOfOneRankEndsTheJob) {
   std::vector<std::string> launcher = kTwoRanks;
   launcher.insert(launcher.begin(), {"timeout", "300"});
@@ -80,8 +84,35 @@ TEST(RunMpi, AnErrorOfOneRankEndsTheJob) {
        "/proc/no/such/folder", "--levels", "0"},
       launcher);
   EXPECT_EQ(r.exit_code, 1) << r.err;  // timeout's 124 when the job hangs
-  EXPECT_NE(r.err.find("[rank 0] hexbite: failed: cannot create the output folder"), std::string::npos)
+  EXPECT_EQ(count(r.err, "hexbite: failed: cannot create the output folder '/proc/no/such/folder'"), 1u)
       << r.err;
+  EXPECT_EQ(count(r.err, "[rank"), 0u) << r.err;
+}
+
+// Rank 1's piece cannot be moved into place (a folder of its name is in the way): the run used to leave
+// rank 0's new mesh.vtu and solution.pvtu beside the earlier results.json, print the error with rank 1's
+// prefix and abort the job. Now nothing moves, and rank 0 reports.
+TEST(RunMpi, APieceThatCannotBeMovedInLeavesTheFolderAsItWas) {
+  const std::string out = test::temp_dir() + "/out";
+  fs::create_directories(out + "/solution_1.vtu/mine");
+  for (const char* name : {"results.json", "mesh.vtu", "solution.pvtu", "solution_0.vtu", "model.inp"})
+    test::write_file(out + "/" + name, std::string("earlier ") + name + "\n");
+  const std::map<std::string, std::string> before = test::files_under(out);
+  std::vector<std::string> launcher = kTwoRanks;
+  launcher.insert(launcher.begin(), {"timeout", "300"});
+  const test::CommandResult r = test::run_hexbite(
+      {"-q", "run", std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml", "-o", out,
+       "--levels", "0"},
+      launcher);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(count(r.err, "hexbite: failed: cannot write '" + out +
+                             "/solution_1.vtu': a folder of that name is in the way; remove or rename it, or "
+                             "choose another output folder; the run kept none of its files and left '" +
+                             out + "' as it was\n"),
+            1u)
+      << r.err;
+  EXPECT_EQ(count(r.err, "[rank"), 0u) << r.err;
+  test::expect_same_files(before, test::files_under(out));
 }
 
 TEST(RunMpi, TwoRanksGiveTheSerialFigures) {

@@ -82,6 +82,28 @@ std::string shared_data(const std::string& relative) {
   return path;
 }
 
+std::map<std::string, std::string> files_under(const std::string& dir) {
+  std::map<std::string, std::string> files;
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(dir)) {
+    const std::string name = fs::relative(e.path(), dir).string();
+    files[name] = e.is_directory() ? "<folder>" : read_file(e.path().string());
+  }
+  return files;
+}
+
+void expect_same_files(const std::map<std::string, std::string>& before,
+                       const std::map<std::string, std::string>& after) {
+  for (const auto& [name, contents] : before) {
+    const auto it = after.find(name);
+    if (it == after.end())
+      ADD_FAILURE() << name << " is gone";
+    else if (it->second != contents)
+      ADD_FAILURE() << name << " changed";
+  }
+  for (const auto& [name, contents] : after)
+    if (before.count(name) == 0) ADD_FAILURE() << name << " is new";
+}
+
 std::string cubes_obj(int cubes) {
   std::string text;
   const int faces[12][3] = {{1, 3, 4}, {1, 4, 2}, {5, 6, 8}, {5, 8, 7}, {1, 2, 6}, {1, 6, 5},

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,14 @@ std::string shared_data(const std::string& relative);
 // Reads or writes a whole file.
 std::string read_file(const std::string& path);
 void write_file(const std::string& path, const std::string& contents);
+
+// Everything under `dir`: relative name -> the file's bytes, or "<folder>" for a folder.
+std::map<std::string, std::string> files_under(const std::string& dir);
+
+// Test failures naming every file added, removed or changed between two files_under() of one folder
+// (without printing the contents, which may be megabytes).
+void expect_same_files(const std::map<std::string, std::string>& before,
+                       const std::map<std::string, std::string>& after);
 
 // Separate 20 mm cubes (x 0-20, 40-60, ...) as OBJ text, outward triangles.
 std::string cubes_obj(int cubes);

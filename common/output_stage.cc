@@ -1,0 +1,128 @@
+#include "common/output_stage.h"
+
+#include <stdlib.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <set>
+
+#include "common/error.h"
+
+namespace hexbite {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// "out/" and "out" are the same folder; keep the spelling the user gave otherwise.
+std::string without_trailing_separator(std::string dir) {
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  return dir;
+}
+
+}  // namespace
+
+OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separator(dir)) {
+  // The folders that do not exist yet, deepest first: a failed run removes them again.
+  std::error_code ec;
+  for (fs::path p = fs::path(dir_); !p.empty() && !fs::exists(fs::symlink_status(p, ec));
+       p = p.parent_path()) {
+    created_.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  fs::create_directories(dir_, ec);
+  if (ec) {
+    discard();
+    throw RunError("cannot create the output folder '" + dir_ + "': " + ec.message());
+  }
+  std::string name = (fs::path(dir_) / ".hexbite-stage-XXXXXX").string();
+  if (::mkdtemp(name.data()) == nullptr) {
+    const std::string reason = std::strerror(errno);
+    discard();
+    throw RunError("cannot write in the output folder '" + dir_ + "': " + reason +
+                   "; make it writable or choose another output folder");
+  }
+  stage_ = name;
+}
+
+OutputStage::~OutputStage() {
+  if (!done_) discard();
+}
+
+void OutputStage::discard() noexcept {
+  done_ = true;
+  std::error_code ec;
+  if (!stage_.empty()) fs::remove_all(stage_, ec);
+  for (const fs::path& p : created_) fs::remove(p, ec);  // only if empty: never what others put there
+}
+
+void OutputStage::commit(const std::vector<std::string>& files,
+                         const std::function<bool(const std::string&)>& retire) {
+  const fs::path dir(dir_), stage(stage_), previous = fs::path(stage_) / ".previous";
+  // Every move done so far, to be undone (last first) when a later one fails.
+  struct Move {
+    fs::path from, to;
+  };
+  std::vector<Move> done;
+  const auto move = [&](const fs::path& from, const fs::path& to, const fs::path& named) {
+    std::error_code ec;
+    fs::rename(from, to, ec);
+    if (ec) throw RunError("cannot write '" + named.string() + "': " + ec.message());
+    done.push_back({from, to});
+  };
+  try {
+    std::error_code ec;
+    fs::create_directory(previous, ec);
+    if (ec) throw RunError("cannot write in the output folder '" + dir_ + "': " + ec.message());
+    // The earlier run's files that this one does not rewrite go aside first (folders of such names are
+    // not outputs and stay).
+    const std::set<std::string> writing(files.begin(), files.end());
+    if (retire) {
+      std::vector<std::string> stale;
+      for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        std::error_code kind;
+        if (retire(name) && writing.count(name) == 0 && !entry.is_directory(kind)) stale.push_back(name);
+      }
+      if (ec) throw RunError("cannot list the output folder '" + dir_ + "': " + ec.message());
+      std::sort(stale.begin(), stale.end());
+      for (const std::string& name : stale) move(dir / name, previous / name, dir / name);
+    }
+    for (const std::string& name : files) {
+      const fs::path target = dir / name, staged = stage / name;
+      if (!fs::is_regular_file(staged, ec))
+        throw RunError("cannot write '" + target.string() + "': it was not written to " + stage_ +
+                       " (under mpirun the output folder must be on a file system that every rank sees)");
+      const fs::file_status old = fs::symlink_status(target, ec);
+      if (fs::is_directory(old))
+        throw RunError("cannot write '" + target.string() +
+                       "': a folder of that name is in the way; remove or rename it, or choose another "
+                       "output folder");
+      if (fs::exists(old)) move(target, previous / name, target);
+      move(staged, target, target);
+    }
+  } catch (const std::exception& e) {
+    // Undo, last move first. Should that fail too (it renames within the same folders), the stage is kept
+    // so that no earlier file is lost, and the message says where they are.
+    std::string stuck;
+    for (auto it = done.rbegin(); it != done.rend(); ++it) {
+      std::error_code ec;
+      fs::rename(it->to, it->from, ec);
+      if (ec) stuck += (stuck.empty() ? "" : ", ") + it->to.string();
+    }
+    if (!stuck.empty()) {
+      done_ = true;  // keep the stage
+      throw RunError(std::string(e.what()) + "; moving the earlier files back failed as well: " + stuck +
+                     " are in " + stage_ + ", move them back by hand");
+    }
+    discard();
+    throw;
+  }
+  done_ = true;
+  // The set is in place; what is left in the stage are the earlier run's replaced files.
+  std::error_code ec;
+  fs::remove_all(stage_, ec);
+}
+
+}  // namespace hexbite

@@ -1,0 +1,58 @@
+// Writing a set of output files all-or-nothing.
+//
+// Why: write_atomically (common/atomic_file.h) keeps every single file whole, but a command that writes
+// several files (hexbite run: results.json, mesh.vtu, the solution files, model.inp) and fails after the
+// first of them (disk full, a folder in the way of a file name, a late refusal) left the new files beside
+// those of an earlier run in the same folder: a script could read this run's results.json with the last
+// run's solution, or the reverse. An OutputStage collects the whole set in a hidden folder inside the
+// output folder (so that moving the files into place is a rename on the same file system), and only
+// commit() moves it into place; a failure of commit() puts everything back. Whatever fails, the output
+// folder ends as it was: the earlier files untouched and, if the folder did not exist, not created.
+//
+// A process killed in the middle (SIGKILL, a node lost) can leave the hidden folder (.hexbite-stage-*)
+// behind, but never a mixed set.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace hexbite {
+
+class OutputStage {
+ public:
+  // Creates `dir` (and its missing parents) when it does not exist, and the stage inside it.
+  // Throws RunError naming the folder when either cannot be created.
+  explicit OutputStage(const std::string& dir);
+  // Discards the stage (and the folders the constructor created) unless commit() succeeded.
+  ~OutputStage();
+  OutputStage(const OutputStage&) = delete;
+  OutputStage& operator=(const OutputStage&) = delete;
+
+  // The output folder as given, and the folder to write the files of the set into (under their final
+  // names, e.g. stage_dir() + "/results.json").
+  const std::string& dir() const { return dir_; }
+  const std::string& stage_dir() const { return stage_; }
+  // Whether the constructor created the output folder.
+  bool created_dir() const { return !created_.empty(); }
+
+  // Moves the staged `files` (names relative to the folders, in this order) into the output folder,
+  // replacing files of those names, and removes the other files of the output folder for which
+  // `retire(name)` is true (files of an earlier run that this one does not rewrite). All or nothing: when
+  // a move fails (a folder in the way of a name, a file missing from the stage), everything done is undone
+  // and RunError names the file and what to do. Then removes the stage.
+  void commit(const std::vector<std::string>& files,
+              const std::function<bool(const std::string&)>& retire = nullptr);
+
+  // Removes the stage and the folders the constructor created (these only when empty). Never throws.
+  void discard() noexcept;
+
+ private:
+  std::string dir_;
+  std::string stage_;
+  std::vector<std::filesystem::path> created_;  // folders the constructor created, deepest first
+  bool done_ = false;                           // committed or discarded
+};
+
+}  // namespace hexbite

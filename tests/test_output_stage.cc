@@ -1,0 +1,109 @@
+// OutputStage (common/output_stage.h): a set of files moves into its folder whole or not at all, and a
+// failure leaves the folder as it was, the files of an earlier run byte for byte.
+#include "common/output_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "common/error.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool is_output(const std::string& name) {
+  return name.rfind("out_", 0) == 0;
+}
+
+TEST(OutputStage, CommitMovesTheSetInAndRemovesTheEarlierRunsOtherOutputs) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/out_a", "old a\n");
+  test::write_file(dir + "/out_stale", "old stale\n");
+  test::write_file(dir + "/notes.txt", "mine\n");
+  fs::create_directory(dir + "/out_folder");  // a folder of an output's name is no output: it stays
+  {
+    OutputStage stage(dir);
+    EXPECT_FALSE(stage.created_dir());
+    EXPECT_EQ(fs::path(stage.stage_dir()).parent_path(), fs::path(dir));
+    test::write_file(stage.stage_dir() + "/out_a", "new a\n");
+    test::write_file(stage.stage_dir() + "/out_b", "new b\n");
+    EXPECT_FALSE(fs::exists(dir + "/out_b"));  // nothing moves before commit
+    stage.commit({"out_a", "out_b"}, is_output);
+  }
+  const std::map<std::string, std::string> expected = {
+      {"out_a", "new a\n"}, {"out_b", "new b\n"}, {"notes.txt", "mine\n"}, {"out_folder", "<folder>"}};
+  EXPECT_EQ(test::files_under(dir), expected);
+}
+
+// The last file's name is taken by a folder: the files already moved go back, the earlier ones return.
+TEST(OutputStage, AFolderInTheWayOfTheLastFileLeavesTheFolderAsItWas) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/out_a", "old a\n");
+  test::write_file(dir + "/out_stale", "old stale\n");
+  fs::create_directory(dir + "/out_c");
+  test::write_file(dir + "/out_c/inside", "mine\n");
+  const std::map<std::string, std::string> before = test::files_under(dir);
+  std::string message;
+  {
+    OutputStage stage(dir);
+    for (const char* name : {"out_a", "out_b", "out_c"})
+      test::write_file(stage.stage_dir() + "/" + name, std::string("new ") + name + "\n");
+    message = test::message_of<RunError>([&] { stage.commit({"out_a", "out_b", "out_c"}, is_output); });
+  }
+  EXPECT_NE(message.find("cannot write '" + dir +
+                         "/out_c': a folder of that name is in the way; remove or "
+                         "rename it, or choose another output folder"),
+            std::string::npos)
+      << message;
+  test::expect_same_files(before, test::files_under(dir));  // no stage left either
+}
+
+// A file that a writer (another rank) should have put into the stage and did not.
+TEST(OutputStage, AFileMissingFromTheStageIsRefusedAndNothingMoves) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/out_a", "old a\n");
+  const std::map<std::string, std::string> before = test::files_under(dir);
+  OutputStage stage(dir);
+  test::write_file(stage.stage_dir() + "/out_a", "new a\n");
+  const std::string message = test::message_of<RunError>([&] {
+    stage.commit({"out_a", "out_missing"}, is_output);
+  });
+  EXPECT_NE(message.find("cannot write '" + dir + "/out_missing': it was not written"), std::string::npos)
+      << message;
+  test::expect_same_files(before, test::files_under(dir));
+}
+
+// A folder that did not exist (nor its parent) is gone again when the set is given up.
+TEST(OutputStage, AGivenUpSetLeavesNoFolderItCreated) {
+  const std::string root = test::temp_dir();
+  const std::string dir = root + "/new/out/";
+  {
+    OutputStage stage(dir);
+    EXPECT_TRUE(stage.created_dir());
+    EXPECT_EQ(stage.dir(), root + "/new/out");
+    test::write_file(stage.stage_dir() + "/out_a", "new a\n");
+  }  // not committed
+  EXPECT_TRUE(fs::is_empty(root));
+  {
+    OutputStage stage(dir);
+    test::write_file(stage.stage_dir() + "/out_a", "new a\n");
+    stage.commit({"out_a"}, is_output);
+  }
+  EXPECT_EQ(test::files_under(root + "/new/out"), (std::map<std::string, std::string>{{"out_a", "new a\n"}}));
+}
+
+TEST(OutputStage, AnOutputFolderThatCannotBeCreatedIsNamed) {
+  const std::string root = test::temp_dir();
+  test::write_file(root + "/file", "x\n");
+  const std::string message = test::message_of<RunError>([&] { OutputStage stage(root + "/file/out"); });
+  EXPECT_NE(message.find("cannot create the output folder '" + root + "/file/out'"), std::string::npos)
+      << message;
+}
+
+}  // namespace
+}  // namespace hexbite
