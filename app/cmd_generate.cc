@@ -143,8 +143,14 @@ void add_generate_commands(CLI::App& app) {
   cmd->add_option("--variant", args->variant, "dentate, edentulous or atrophic (resorbed, low body)");
   // One option per row of the generator's table of dimensions, its range and the variants' defaults
   // printed from that table, so that the help cannot drift from what the generator accepts.
-  for (const MandibleDimension& dim : mandible_dimensions())
-    cmd->add_option(std::string("--") + dim.option, p.*dim.field, dimension_help(dim));
+  // The range is checked while parsing: an explicit 0 would otherwise read as "not given" and silently
+  // become the default (complete_parameters).
+  for (const MandibleDimension& dim : mandible_dimensions()) {
+    char range[64];
+    std::snprintf(range, sizeof range, "from %g to %g", dim.lo, dim.hi);
+    cmd->add_option(std::string("--") + dim.option, p.*dim.field, dimension_help(dim))
+        ->check(number_in_range(dim.lo, dim.hi, range));
+  }
   cmd->callback([args] { run_generate(*args); });
 }
 

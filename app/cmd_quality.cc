@@ -12,6 +12,7 @@
 
 #include "app/commands.h"
 #include "app/option_checks.h"
+#include "common/progress.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
@@ -122,7 +123,7 @@ void add_quality_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "quality",
       "Print the quality of a hex mesh (scaled Jacobian, condition number, Oddy, inverted elements)");
-  cmd->add_option("mesh", options->mesh, "Hex mesh file (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
+  cmd->add_option("MESH", options->mesh, "Hex mesh file (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
   cmd->add_flag("--json", options->json, "Print one JSON object instead of the table");
   CLI::Option* worst_option =
       cmd->add_option(
@@ -143,7 +144,7 @@ void add_quality_command(CLI::App& app) {
       nlohmann::json j = quality_to_json(summary, hex_mesh_volume(mesh));
       if (list_worst) j["worst"] = worst_json(worst);
       std::cout << j.dump(2) << '\n';
-    } else {
+    } else if (!is_quiet()) {  // --quiet: like every other report, only the exit code tells
       std::cout << quality_table(options->mesh, summary);
       if (!worst.empty()) std::cout << worst_table(worst);
     }

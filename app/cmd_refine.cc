@@ -234,7 +234,7 @@ void add_refine_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "refine",
       "Split every hex into 8 (boundary nodes onto the surface), for coarse-against-fine validation");
-  cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
+  cmd->add_option("MESH", o->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
   cmd->add_option(
       "--surface", o->surface,
       "Closed surface the mesh fills (.stl .obj .ply .off .vtp); new boundary nodes are projected "

@@ -159,7 +159,7 @@ void add_reorder_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "reorder",
       "Renumber hexes and nodes (breadth-first or reverse Cuthill-McKee) to shrink the matrix bandwidth");
-  cmd->add_option("mesh", o->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
+  cmd->add_option("MESH", o->mesh, "Hex mesh (.vtu, or Gmsh .msh 4.1 / 2.2 ASCII)")->required();
   cmd->add_option(
          "-o,--output", o->output,
          "Reordered mesh: .vtu (the input's arrays carried over), .inp (Abaqus / CalculiX) or .msh (Gmsh)")

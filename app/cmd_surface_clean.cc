@@ -120,16 +120,21 @@ void add_surface_clean_command(CLI::App& surface) {
   cmd->add_option("-o,--output", options->output, "Cleaned surface, in mm (format from the extension)")
       ->required()
       ->check(output_surface_file());
+  // Ranges checked while parsing, like every real-valued option: CLI11 alone says "Could not convert:
+  // --min-angle = abc" (no range), and the later check wrote the value as "45.000000".
   cmd->add_option("--min-angle", options->clean.min_angle_deg,
                   "Remove triangles with an angle below this, in degrees (0 to 30)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(number_in_range(0, 30, "from 0 to 30 (degrees; the seed paper uses 5)"));
   cmd->add_option("--target-triangles", options->clean.target_triangles,
                   "Reduce the surface to at most this many triangles (0: no reduction)")
       ->capture_default_str()
       ->transform(count_in_range(0, std::numeric_limits<int>::max()));
   cmd->add_option("--max-deviation", options->clean.max_deviation_mm,
                   "Bound on the Hausdorff distance between the input and the result, in mm")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(number_in_range(std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
+                              "greater than 0 (a distance in mm)"));
   cmd->add_option("--units", options->units, "Length unit of the input's coordinates: mm, cm or m")
       ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print the report as one JSON object on standard output");

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "app/commands.h"
 #include "app/option_checks.h"
@@ -83,7 +84,9 @@ void add_surface_from_ct_command(CLI::App& surface) {
   cmd->add_option("VOLUME", args->volume, "CT volume file")->required();
   cmd->add_option("--threshold", args->threshold,
                   "Iso-value in the volume's units (e.g. Hounsfield units; the built-in mandible uses 620)")
-      ->required();
+      ->required()
+      ->check(number_in_range(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                              "that is finite, in the volume's units (e.g. 620 Hounsfield units)"));
   cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")
       ->required()
       ->check(output_surface_file());

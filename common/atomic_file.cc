@@ -34,7 +34,7 @@ void write_atomically(const std::string& final_path, const std::function<void(co
   std::error_code ec;
   fs::rename(tmp, target, ec);
   if (ec) {
-    std::error_code ignored;  // not ec: the message said "Success", the outcome of this remove
+    std::error_code ignored;  // not ec: a remove that finds nothing clears it ("cannot write ...: Success")
     fs::remove(tmp, ignored);
     throw RunError("cannot write '" + final_path + "': " + ec.message());
   }
@@ -43,7 +43,9 @@ void write_atomically(const std::string& final_path, const std::function<void(co
 void write_file_atomically(const std::string& final_path, const std::string& contents) {
   write_atomically(final_path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw RunError("cannot open '" + tmp + "' for writing: " + std::strerror(errno));
+    if (!out)
+      throw RunError("cannot write '" + final_path + "': " + std::strerror(errno) + " (creating '" + tmp +
+                     "' beside it to write into first)");
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.close();
     if (!out) throw RunError("cannot write '" + final_path + "': disk full or not writable");

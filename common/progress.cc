@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <iostream>
 
 namespace hexbite {
@@ -50,8 +51,19 @@ Progress::Progress(std::string label)
   if (active_) draw(0.0, "", false);
 }
 
+// A step that ends in an exception did not complete: its bar is wiped rather than drawn at 100 % just
+// above the error.
 Progress::~Progress() {
-  if (!finished_) finish();
+  if (finished_) return;
+  if (std::uncaught_exceptions() == 0) {
+    finish();
+    return;
+  }
+  finished_ = true;
+  if (active_) {
+    std::fputs("\r\033[K", stderr);
+    std::fflush(stderr);
+  }
 }
 
 double Progress::seconds() const {

@@ -26,12 +26,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <vector>
 
 #include "common/error.h"
 #include "common/paths.h"
+#include "mesher/vtk_messages.h"
 
 namespace hexbite {
 
@@ -82,11 +84,46 @@ struct ErrorCatcher {
   }
 };
 
+// The explanation in VTK's error text ("ERROR: In ...\nvtkMetaImageReader (0x55...): explanation\n\n"),
+// without the class and address, which tell a user nothing.
 std::string first_line(std::string s) {
   while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
   const auto nl = s.rfind('\n');
-  return nl == std::string::npos ? s : s.substr(nl + 1);
+  if (nl != std::string::npos) s = s.substr(nl + 1);
+  const auto object = s.find("): ");
+  return object == std::string::npos ? s : s.substr(object + 3);
 }
+
+// MetaIO, inside VTK's MetaImage reader, prints its complaints about a file to std::cerr by itself
+// ("ElementDataFile required and not defined.", each twice): kept here while a volume is read, so that they
+// become the reason of the one error instead of stray lines before it.
+class CerrCapture {
+ public:
+  CerrCapture() : previous_(std::cerr.rdbuf(text_.rdbuf())) {}
+  ~CerrCapture() { std::cerr.rdbuf(previous_); }
+  CerrCapture(const CerrCapture&) = delete;
+  CerrCapture& operator=(const CerrCapture&) = delete;
+
+  // " (MetaIO: line; line)", each distinct line once, or "" when nothing was printed.
+  std::string reason() const {
+    std::istringstream in(text_.str());
+    std::vector<std::string> seen;
+    std::string joined;
+    for (std::string line; std::getline(in, line);) {
+      while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+      line.erase(0, line.find_first_not_of(" \t"));
+      if (line.empty() || std::find(seen.begin(), seen.end(), line) != seen.end()) continue;
+      seen.push_back(line);
+      joined += (joined.empty() ? "" : "; ") + line;
+    }
+    return joined.empty() ? std::string() : " (MetaIO: " + joined + ")";
+  }
+  bool said(const std::string& words) const { return text_.str().find(words) != std::string::npos; }
+
+ private:
+  std::ostringstream text_;
+  std::streambuf* previous_;
+};
 
 vtkSmartPointer<vtkImageData> to_image(const VoxelVolume& volume, int pad, float pad_value) {
   const auto& d = volume.dims;
@@ -192,6 +229,8 @@ VoxelVolume read_volume(const std::string& path) {
   if (fs::is_directory(path)) throw InputError("'" + path + "' is a folder, not a volume file");
 
   ErrorCatcher errors;
+  const VtkMessageCapture muted;  // VTK's logger prints a failed pipeline request in colour by itself
+  const CerrCapture metaio;
   vtkSmartPointer<vtkImageData> image;
   vtkSmartPointer<vtkMatrix4x4> orientation;
   double slope = 1, intercept = 0;
@@ -200,9 +239,16 @@ VoxelVolume read_volume(const std::string& path) {
     auto reader = vtkSmartPointer<vtkMetaImageReader>::New();
     errors.watch(reader);
     if (!reader->CanReadFile(path.c_str()))
-      throw InputError("'" + path + "' is not a readable MetaImage file (header missing or malformed)");
+      throw InputError("'" + path + "' is not a readable MetaImage file (header missing or malformed)" +
+                       metaio.reason());
     reader->SetFileName(path.c_str());
     reader->Update();
+    // A file cut off in its voxel data is read without an error: MetaIO only prints that it got less than
+    // the header announced, and the missing voxels would make half a bone.
+    if (metaio.said("data not read completely"))
+      throw InputError("volume '" + path +
+                       "' is cut off: it holds less voxel data than its header announces" + metaio.reason() +
+                       "; export or download it again");
     image = reader->GetOutput();
     orientation = metaimage_orientation(path);
   } else {
@@ -236,7 +282,8 @@ VoxelVolume read_volume(const std::string& path) {
   }
   if (!errors.message.empty() || !image || !image->GetPointData()->GetScalars())
     throw InputError("cannot read volume '" + path + "'" +
-                     (errors.message.empty() ? std::string() : ": " + first_line(errors.message)));
+                     (errors.message.empty() ? std::string() : ": " + first_line(errors.message)) +
+                     metaio.reason());
   vtkDataArray* scalars = image->GetPointData()->GetScalars();
   if (scalars->GetNumberOfComponents() != 1)
     throw InputError("volume '" + path + "' has " + std::to_string(scalars->GetNumberOfComponents()) +
@@ -321,6 +368,7 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
 
   auto image = to_image(volume, 0, 0.0f);
   ErrorCatcher errors;
+  const VtkMessageCapture muted;
   if (fmt.format == VolumeFormat::kMetaImage) {
     auto writer = vtkSmartPointer<vtkMetaImageWriter>::New();
     errors.watch(writer);

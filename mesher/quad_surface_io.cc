@@ -8,11 +8,13 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -79,9 +81,10 @@ QuadSurface read_obj(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    line = line.substr(0, line.find('#'));  // a comment, also at the end of a line, as for triangle OBJ
     std::istringstream tokens(line);
     std::string key;
-    if (!(tokens >> key) || key[0] == '#') continue;
+    if (!(tokens >> key)) continue;
     const std::string where = "line " + std::to_string(line_no);
     std::vector<std::string> rest;
     for (std::string t; tokens >> t;) rest.push_back(t);
@@ -205,12 +208,130 @@ QuadSurface read_vtp(const std::string& path) {
   return from_polydata(path, reader->GetOutput());
 }
 
+// Bytes of one value of a legacy VTK data type; 0 for a type not known here.
+std::size_t legacy_type_size(std::string type) {
+  std::transform(type.begin(), type.end(), type.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (type == "char" || type == "unsigned_char" || type == "vtktypeint8" || type == "vtktypeuint8") return 1;
+  if (type == "short" || type == "unsigned_short" || type == "vtktypeint16" || type == "vtktypeuint16")
+    return 2;
+  if (type == "int" || type == "unsigned_int" || type == "float" || type == "vtktypeint32" ||
+      type == "vtktypeuint32")
+    return 4;
+  if (type == "long" || type == "unsigned_long" || type == "double" || type == "vtktypeint64" ||
+      type == "vtktypeuint64" || type == "vtkidtype")
+    return 8;
+  return 0;
+}
+
+// VTK 9.1's legacy reader crashes (segmentation fault) when a cell section ends early or holds something
+// other than an integer: it closes the file and reads on. And a CONNECTIVITY section (file version 5) that
+// ends early is read with made-up indices. So the counts of the POINTS and cell sections are checked here
+// first, by values (ASCII) or bytes (BINARY); the rest of the file (attributes) is left to VTK.
+void require_complete_legacy_sections(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto upper = [](std::string w) {
+    std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return std::toupper(c); });
+    return w;
+  };
+  auto number = [](const std::string& text, auto& value) {
+    const char* end = text.data() + text.size();
+    return !text.empty() && std::from_chars(text.data(), end, value).ptr == end;
+  };
+  const std::size_t header_end = std::min(bytes.find('\n'), bytes.size());
+  const std::size_t v = bytes.substr(0, header_end).find("Version ");
+  const int version = v == std::string::npos ? 0 : std::atoi(bytes.c_str() + v + 8);
+  std::size_t at = std::min(bytes.find('\n', header_end + 1), bytes.size());  // the end of the title line
+  long line = 2;                                                              // the line of `at`
+  auto skip_space = [&] {
+    for (; at < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[at])); ++at)
+      line += bytes[at] == '\n';
+  };
+  // The words of the next line that holds any (the format, or a keyword line); `at` stays at its end.
+  auto next_line = [&] {
+    skip_space();
+    const std::size_t end = std::min(bytes.find('\n', at), bytes.size());
+    std::istringstream text(bytes.substr(at, end - at));
+    at = end;
+    std::vector<std::string> words;
+    for (std::string w; text >> w;) words.push_back(w);
+    return words;
+  };
+  const std::vector<std::string> format = next_line();
+  const bool binary = !format.empty() && upper(format[0]) == "BINARY";
+  if (!binary && (format.empty() || upper(format[0]) != "ASCII")) return;  // VTK names the header's fault
+
+  // Reads past the values of `type` after a keyword line: `items` of `per_item` values each, as `announced`
+  // says ("4 points"). False for a type not known here (VTK's message then).
+  auto skip_values = [&](const std::string& section, long long items, int per_item,
+                         const std::string& announced, const std::string& type, bool integers) {
+    const auto cut_off = [&] {
+      return InputError(quoted(path) + ": the file ends inside its " + section +
+                        " section, which announces " + announced + ": it was cut off; export it again");
+    };
+    // More items than bytes cannot be there (and their product could overflow).
+    if (items > static_cast<long long>(bytes.size())) throw cut_off();
+    const long long count = items * per_item;
+    if (binary) {
+      const std::size_t size = legacy_type_size(type);
+      if (size == 0) return false;
+      if (at < bytes.size()) ++at, ++line;  // the keyword line's '\n'; the data follows it at once
+      if (static_cast<unsigned long long>(count) > (bytes.size() - at) / size) throw cut_off();
+      at += static_cast<std::size_t>(count) * size;
+      return true;
+    }
+    for (long long i = 0; i < count; ++i) {
+      skip_space();
+      const std::size_t begin = at;
+      while (at < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
+      const std::string value = bytes.substr(begin, at - begin);
+      if (value.empty()) throw cut_off();
+      long long integer = 0;
+      double real = 0;
+      if (!(integers ? number(value, integer) : number(value, real)))
+        throw InputError(quoted(path) + " line " + std::to_string(line) + ": '" + value + "' in its " +
+                         section + " section is not " + (integers ? "an integer" : "a number") +
+                         "; fix the file or export it again");
+    }
+    return true;
+  };
+  for (;;) {
+    const std::vector<std::string> words = next_line();
+    const std::string keyword = words.empty() ? std::string() : upper(words[0]);
+    long long count = 0, size = 0;
+    if (keyword == "DATASET") continue;
+    if (keyword == "POINTS") {
+      if (words.size() < 3 || !number(words[1], count) || count < 0 ||
+          !skip_values("POINTS", count, 3, std::to_string(count) + " points", words[2], false))
+        return;
+      continue;
+    }
+    if (keyword != "VERTICES" && keyword != "LINES" && keyword != "POLYGONS" && keyword != "TRIANGLE_STRIPS")
+      return;  // the end, or attributes: VTK reads them
+    if (words.size() < 3 || !number(words[1], count) || !number(words[2], size) || count < 0 || size < 0)
+      return;
+    if (version < 5) {
+      if (!skip_values(keyword, size, 1, std::to_string(size) + " values", "int", true)) return;
+      continue;
+    }
+    for (const std::string part : {"OFFSETS", "CONNECTIVITY"}) {
+      const std::vector<std::string> part_words = next_line();
+      const long long values = part == "OFFSETS" ? count : size;
+      if (part_words.size() < 2 || upper(part_words[0]) != part ||
+          !skip_values(keyword + " " + part, values, 1, std::to_string(values) + " values", part_words[1],
+                       true))
+        return;
+    }
+  }
+}
+
 QuadSurface read_legacy_vtk(const std::string& path) {
   VtkMessageCapture capture;
   vtkNew<vtkPolyDataReader> reader;
   reader->SetFileName(path.c_str());
   if (!reader->IsFilePolyData())
     throw InputError(quoted(path) + " is not a legacy VTK polydata file (DATASET POLYDATA)");
+  require_complete_legacy_sections(path);
   reader->Update();
   if (reader->GetErrorCode() != 0 || !capture.errors().empty())
     throw InputError(quoted(path) + " could not be read as legacy VTK polydata (truncated or corrupt file" +

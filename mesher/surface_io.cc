@@ -200,15 +200,16 @@ float get_f32(const std::string& bytes, std::size_t at) {
   return f;
 }
 
-// A text STL contains only printable characters and white space; any other byte means binary,
-// whatever the first 80 bytes say (many binary exporters start their header with "solid").
+// A text STL contains no control characters but white space; any other one (a binary record's zero
+// attribute bytes, for one) means binary, whatever the first 80 bytes say (many binary exporters start
+// their header with "solid"). Bytes from 128 up are text: a solid named in UTF-8 ("solid Unterkiefer_ä").
 bool looks_like_ascii_stl(const std::string& bytes) {
   std::size_t i = 0;
   while (i < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[i]))) ++i;
   if (bytes.compare(i, 5, "solid") != 0) return false;
   return std::all_of(bytes.begin(), bytes.end(), [](char ch) {
     const auto c = static_cast<unsigned char>(ch);
-    return (c >= 32 && c < 127) || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v';
+    return (c >= 32 && c != 127) || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v';
   });
 }
 
@@ -418,7 +419,9 @@ TriSurface read_off(const std::string& path) {
     throw malformed("the counts 'vertices faces edges' as non-negative integers");
 
   TriSurface s;
-  s.vertices.reserve(static_cast<std::size_t>(nv));
+  // The count is the file's word: a damaged header ("2000000000 1 0") must not reserve more than the file
+  // can hold (a vertex line takes at least 6 bytes), or it ends in std::bad_alloc instead of "cut off".
+  s.vertices.reserve(std::min(static_cast<std::size_t>(nv), bytes.size() / 6));
   for (long long i = 0; i < nv; ++i) {
     next_nonblank("vertex " + std::to_string(i) + " of " + std::to_string(nv));
     Vec3 p;
@@ -839,7 +842,8 @@ std::string ply_bytes(const TriSurface& s) {
   return out;
 }
 
-void write_vtp(const std::string& tmp_path, const TriSurface& s) {
+// Writes `s` to tmp_path, the temporary of path (named in the error).
+void write_vtp(const std::string& tmp_path, const std::string& path, const TriSurface& s) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(s.vertices.size()));
@@ -861,8 +865,9 @@ void write_vtp(const std::string& tmp_path, const TriSurface& s) {
   writer->SetFileName(tmp_path.c_str());
   writer->SetInputData(data);
   writer->SetDataModeToBinary();
-  if (writer->Write() != 1)
-    throw RunError("cannot write " + quoted(tmp_path) + ": " +
+  // VTK 9.1's writer returns 1 also when it could not open the file; what it printed tells.
+  if (writer->Write() != 1 || !capture.errors().empty())
+    throw RunError("cannot write " + quoted(path) + ": " +
                    (capture.errors().empty() ? std::string("VTK writer failed") : capture.errors()));
 }
 
@@ -899,7 +904,7 @@ void write_surface(const std::string& path, const TriSurface& surface) {
   const std::string ext = lower_extension(path);
   require_known_extension(path, ext, "write");
   if (ext == ".vtp") {
-    write_atomically(path, [&](const std::string& tmp) { write_vtp(tmp, surface); });
+    write_atomically(path, [&](const std::string& tmp) { write_vtp(tmp, path, surface); });
     return;
   }
   std::string bytes;

@@ -124,11 +124,18 @@ void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& pn
   grab->ReadFrontBufferOff();
   grab->Update();
   write_atomically(png_path, [&](const std::string& tmp) {
+    // What VTK says goes into the error, not to the terminal as its coloured log; its first error is the
+    // reason (the follow-up "Ran out of disk space" is said of any file that could not be opened).
+    VtkMessageCapture capture;
     vtkNew<vtkPNGWriter> writer;
     writer->SetFileName(tmp.c_str());
     writer->SetInputConnection(grab->GetOutputPort());
     writer->Write();
-    if (writer->GetErrorCode() != 0) throw RunError("cannot write '" + png_path + "'");
+    if (writer->GetErrorCode() != 0 || !capture.errors().empty())
+      throw RunError("cannot write '" + png_path + "'" +
+                     (capture.errors().empty()
+                          ? std::string()
+                          : ": " + capture.errors().substr(0, capture.errors().find("; "))));
   });
 }
 

@@ -2,6 +2,7 @@
 // good and bad input (exit codes, messages, no output file on failure), and --json output that is JSON alone.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -76,6 +77,13 @@ TEST(Cli, UsageErrorsExitTwo) {
   const auto r = run_hexbite({"surface", "check"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("FILE"), std::string::npos) << r.err;
+  // The missing argument is named as in the docs (MESH.vtu), not "mesh is required", which reads like the
+  // mesh command.
+  for (const char* command : {"quality", "reorder", "refine"}) {
+    const auto missing = run_hexbite({command});
+    EXPECT_EQ(missing.exit_code, 2) << command;
+    EXPECT_NE(missing.err.find("MESH is required"), std::string::npos) << command << ": " << missing.err;
+  }
 }
 
 TEST(Cli, RealJawChecksCleanAsJson) {
@@ -303,6 +311,22 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
 }
 
+// An output that cannot be created in a folder that exists (/proc takes no new files, also for root) is a
+// failed run (exit 1) that names the file and why. Before: a .vtp said "cannot write '/proc/x.vtp': Success"
+// (VTK's writer reported success, and the error code of the rename was cleared by the clean-up), and the
+// other formats named only the temporary file ("cannot open '/proc/.x.tmp123.stl' for writing").
+TEST(CliBadInput, AnOutputThatCannotBeCreatedIsNamed) {
+  const std::string cube = write_case("cube.obj", cube_obj());
+  for (const char* ext : {".stl", ".vtp", ".obj"}) {
+    const std::string out = std::string("/proc/hexbite_no_such_output") + ext;
+    const auto r = run_hexbite({"surface", "check", cube, "-o", out});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("hexbite: failed: cannot write '" + out + "': ", 0), 0u) << r.err;
+    EXPECT_EQ(r.err.find("Success"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("No such file or directory"), std::string::npos) << r.err;
+  }
+}
+
 // Not-a-number and infinite values of real-valued options are input errors (exit 2) that give the range, and
 // nothing is written: `mesh --margin nan` crashed (segmentation fault; CLI::Range lets NaN through) and
 // `--refine-at nan,0,0` stopped on a floating-point exception.
@@ -383,6 +407,56 @@ TEST(CliBadInput, SheetsTargetBeyondTheTemplateIsNamedInHexes) {
   EXPECT_NE(r.err.find("the mandible template places on mandibles 30 to 300 mm across"), std::string::npos)
       << r.err;
   EXPECT_TRUE(fs::is_empty(dir));
+}
+
+// One hexahedron, the unit cube, as a Gmsh 2.2 mesh: enough for the commands that read a hex mesh.
+const char* const kCubeMsh =
+    "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n"
+    "6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n$Elements\n1\n1 5 0 1 2 3 4 5 6 7 8\n$EndElements\n";
+
+// --quiet leaves standard output empty for every command's text report (the exit code tells): `quality`
+// printed its whole table under --quiet, unlike surface check, reorder, mesh, refine and run.
+TEST(Cli, QuietLeavesStandardOutputEmpty) {
+  const std::string dir = temp_dir();
+  const std::string cube = write_case("cube.obj", cube_obj());
+  const std::string hex = dir + "/cube.msh";
+  write_file(hex, kCubeMsh);
+  const std::vector<std::vector<std::string>> commands = {
+      {"surface", "check", cube},
+      {"quality", hex},
+      {"quality", hex, "--worst", "1"},
+      {"reorder", hex, "-o", dir + "/ordered.vtu"},
+      {"quad", "from-mesh", hex, "-o", dir + "/quads.obj"},
+      {"quad", "check", dir + "/quads.obj"},
+  };
+  for (std::vector<std::string> args : commands) {
+    args.insert(args.begin(), "--quiet");
+    const auto r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 0) << args[1] << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << args[1] << " printed under --quiet:\n" << r.out.substr(0, 400);
+  }
+}
+
+// On a terminal, a step that failed drew its progress bar at 100 % right above the error ("surface check
+// [####...####] 100%", then "hexbite: error: ... truncated"). The bar of a failed step is wiped now; a step
+// that completes still ends at 100 %. script(1) gives the program a terminal.
+TEST(Cli, AFailedStepDoesNotShowAFullProgressBar) {
+  if (std::system("script --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1) to give a terminal";
+  const std::string dir = temp_dir();
+  auto on_terminal = [&](const std::string& file) {
+    const std::string log = dir + "/log";
+    const std::string command = "script -qec \"'" + std::string(HEXBITE_EXE) + "' surface check '" + file +
+                                "'\" /dev/null >'" + log + "' 2>&1";
+    const int status = std::system(command.c_str());
+    return std::make_pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log));
+  };
+  const auto [bad_code, bad] = on_terminal(write_case("cut.stl", std::string(1000, '\x01')));
+  EXPECT_EQ(bad_code, 2) << bad;
+  EXPECT_NE(bad.find("hexbite: error: "), std::string::npos) << bad;
+  EXPECT_EQ(bad.find("100%"), std::string::npos) << bad;
+  const auto [good_code, good] = on_terminal(write_case("cube.obj", cube_obj()));
+  EXPECT_EQ(good_code, 0) << good;
+  EXPECT_NE(good.find("100%"), std::string::npos) << good;
 }
 
 // With --json, standard output is one JSON document, also without --quiet: `hexbite run ... --json | jq`

@@ -656,6 +656,14 @@ TEST(Cli, GenerateRejectsBadOptionsWithoutWritingAnything) {
       test::run_hexbite({"generate", "mandible", "-o", dir + "/jaw.stl", "--gonial-angle", "170"});
   EXPECT_EQ(bad_range.exit_code, 2);
   EXPECT_NE(bad_range.err.find("--gonial-angle"), std::string::npos) << bad_range.err;
+  // An explicit 0 is out of range too (it was taken as "not given": the default 1 mm voxel, exit 0).
+  for (const char* option : {"--voxel", "--arch-width"}) {
+    const auto zero = test::run_hexbite({"generate", "mandible", "-o", dir + "/jaw.stl", option, "0"});
+    EXPECT_EQ(zero.exit_code, 2) << option << "\n" << zero.err;
+    EXPECT_NE(zero.err.find(std::string(option) + ": 0 is out of range: give a number from "),
+              std::string::npos)
+        << zero.err;
+  }
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
@@ -684,6 +692,41 @@ TEST(Cli, SurfaceFromCtBadInputsExitTwoWithoutOutput) {
   EXPECT_NE(low.err.find("jaw.nii.gz': every voxel of the volume is at or above the threshold"),
             std::string::npos)
       << low.err;
+  // A threshold that is no finite number is an option error, read before the volume (it was blamed on the
+  // file: "'jaw.nii.gz': the threshold must be a finite number").
+  const auto nan =
+      test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "nan", "-o", out});
+  EXPECT_EQ(nan.exit_code, 2);
+  EXPECT_NE(nan.err.find("--threshold: nan is out of range: give a number that is finite"), std::string::npos)
+      << nan.err;
+  EXPECT_FALSE(fs::exists(out));
+  // A cut-off volume is one error line with the reason in it. Before, MetaIO's own lines (each twice) and
+  // VTK's coloured multi-line log came first, and the reason began with the reader's address
+  // ("vtkNIFTIImageReader (0x55...): NIFTI file is truncated").
+  write_volume(dir + "/jaw.mha", generated(MandibleVariant::kAtrophic).ct);
+  const std::string mha = test::read_file(dir + "/jaw.mha");
+  test::write_file(dir + "/cut.mha", mha.substr(0, mha.find("ElementDataFile")));
+  test::write_file(dir + "/cut.nii.gz", test::read_file(dir + "/jaw.nii.gz").substr(0, 3000));
+  for (const std::string cut : {"cut.mha", "cut.nii.gz"}) {
+    const auto r =
+        test::run_hexbite({"surface", "from-ct", dir + "/" + cut, "--threshold", "620", "-o", out});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("hexbite: error: cannot read volume '" + dir + "/" + cut + "': ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.find("(0x"), std::string::npos) << r.err;
+  }
+  EXPECT_NE(test::run_hexbite({"surface", "from-ct", dir + "/cut.mha", "--threshold", "620", "-o", out})
+                .err.find("(MetaIO: "),
+            std::string::npos);
+  // Cut off in its voxel data, a MetaImage file was read without an error: half a bone, exit 0.
+  test::write_file(dir + "/half.mha", mha.substr(0, mha.size() / 2));
+  const auto half =
+      test::run_hexbite({"surface", "from-ct", dir + "/half.mha", "--threshold", "620", "-o", out});
+  EXPECT_EQ(half.exit_code, 2) << half.err;
+  EXPECT_NE(half.err.find("hexbite: error: volume '" + dir +
+                          "/half.mha' is cut off: it holds less voxel data than its header announces"),
+            std::string::npos)
+      << half.err;
   EXPECT_FALSE(fs::exists(out));
   const auto ok =
       test::run_hexbite({"surface", "from-ct", dir + "/jaw.nii.gz", "--threshold", "620", "-o", out});

@@ -2,6 +2,8 @@
 // 3-connected, chords) and `hexbite quad check`.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -181,6 +183,13 @@ TEST(QuadSurfaceIo, RejectsNonQuadsWithTheirPlace) {
   test::write_file(dir + "/slash.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1/1 2//2 -2 4\n");
   const QuadSurface slash = read_quad_surface(dir + "/slash.obj");
   EXPECT_EQ(slash.quads.at(0), (std::array<int, 4>{0, 1, 2, 3}));
+  // A comment at the end of a line is a comment, as in a triangle OBJ: it was taken for two more corners
+  // ("face with 6 corners").
+  test::write_file(dir + "/comment.obj",
+                   "v 0 0 0 # origin\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4 # the quad\n");
+  const QuadSurface commented = read_quad_surface(dir + "/comment.obj");
+  ASSERT_EQ(commented.quads.size(), 1u);
+  EXPECT_EQ(commented.quads[0], (std::array<int, 4>{0, 1, 2, 3}));
 }
 
 TEST(QuadSurfaceIo, LegacyVtkPolydata) {
@@ -196,6 +205,60 @@ TEST(QuadSurfaceIo, LegacyVtkPolydata) {
   test::write_file(dir + "/t.vtk", head + "POLYGONS 2 9\n4 0 1 2 3\n3 1 4 2\n");
   const std::string e = error_of(dir + "/t.vtk");
   EXPECT_NE(e.find("face 1 (0-based) has 3 corners"), std::string::npos) << e;
+}
+
+// VTK 9.1's legacy reader crashed (segmentation fault) on a cell section that ends early or holds a
+// non-integer, and read a cut-off CONNECTIVITY section (file version 5) with a made-up index. Each is now an
+// InputError naming the section; whole files, ASCII and binary, still read.
+TEST(QuadSurfaceIo, CutOffLegacyVtkIsRefusedNotACrash) {
+  const std::string dir = test::temp_dir();
+  const std::string head =
+      "# vtk DataFile Version 3.0\nquads\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0 1 0 0 1 1 0 0 1 0\n";
+  struct Case {
+    std::string name, text, fragment;
+  };
+  const std::vector<Case> cases = {
+      {"short.vtk", head + "POLYGONS 1 5\n4 0 1 2\n",
+       "the file ends inside its POLYGONS section, which announces 5 values: it was cut off"},
+      {"none.vtk", head + "POLYGONS 1 5\n", "the file ends inside its POLYGONS section"},
+      {"word.vtk", head + "POLYGONS 1 5\n4 0 1 2 x\n",
+       "line 8: 'x' in its POLYGONS section is not an integer"},
+      {"lines.vtk", head + "LINES 1 5\n4 0 1\n", "the file ends inside its LINES section"},
+      {"points.vtk", head.substr(0, head.size() - 7) + "\nPOLYGONS 1 5\n4 0 1 2 3\n",
+       "'POLYGONS' in its POINTS section is not a number"},
+      {"v5.vtk",
+       "# vtk DataFile Version 5.1\nquads\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0 1 0 0 1 1 0 0 1 0\n"
+       "POLYGONS 2 4\nOFFSETS vtktypeint64\n0 4\nCONNECTIVITY vtktypeint64\n0 1 2\n",
+       "the file ends inside its POLYGONS CONNECTIVITY section, which announces 4 values"},
+  };
+  for (const Case& c : cases) {
+    test::write_file(dir + "/" + c.name, c.text);
+    const std::string e = error_of(dir + "/" + c.name);
+    EXPECT_NE(e.find("'" + dir + "/" + c.name + "'"), std::string::npos) << e;
+    EXPECT_NE(e.find(c.fragment), std::string::npos) << c.name << ": " << e;
+  }
+  // Binary: big-endian values right after each keyword line.
+  auto be32 = [](std::uint32_t u) {
+    return std::string{char(u >> 24), char(u >> 16), char(u >> 8), char(u)};
+  };
+  auto f32 = [&](float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return be32(u);
+  };
+  std::string binary = "# vtk DataFile Version 3.0\nquads\nBINARY\nDATASET POLYDATA\nPOINTS 4 float\n";
+  for (const float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 0.f}) binary += f32(c);
+  binary += "\nPOLYGONS 1 5\n";
+  for (const std::uint32_t i : {4u, 0u, 1u, 2u, 3u}) binary += be32(i);
+  binary += "\n";
+  test::write_file(dir + "/binary.vtk", binary);
+  const QuadSurface q = read_quad_surface(dir + "/binary.vtk");
+  ASSERT_EQ(q.quads.size(), 1u);
+  EXPECT_EQ(q.quads[0], (std::array<int, 4>{0, 1, 2, 3}));
+  EXPECT_EQ(q.vertices[2], (Vec3{1, 1, 0}));
+  test::write_file(dir + "/binary_cut.vtk", binary.substr(0, binary.size() - 9));
+  const std::string e = error_of(dir + "/binary_cut.vtk");
+  EXPECT_NE(e.find("the file ends inside its POLYGONS section"), std::string::npos) << e;
 }
 
 // A cut-off XML file: VTK's reader reports it only by printing, and that explanation is the error's reason.

@@ -101,6 +101,70 @@ TEST(Render, DamagedMeshIsOneCleanError) {
   EXPECT_FALSE(fs::exists(dir + "/cut.png"));
 }
 
+// Options that the input would ignore, a .vtu named in capitals and non-finite --max values: exit 2 before
+// anything is read or a display is needed. Before: `--field` on a surface and `--max` without `--field` were
+// silently ignored, `--max nan` too, `--max inf` was refused with a 309-digit bound, and `MESH.VTU` was read
+// as a surface ("unknown extension '.vtu'; accepted surface formats are .stl, ...").
+TEST(Render, OptionsTheInputIgnoresAreRefused) {
+  const std::string dir = temp_dir();
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  test::write_file(dir + "/cube.msh",
+                   "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+                   "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n$EndNodes\n$Elements\n1\n1 5 0 1 2 3 4 5 6 7 8\n"
+                   "$EndElements\n");
+  ASSERT_EQ(run_hexbite({"-q", "reorder", dir + "/cube.msh", "-o", dir + "/CUBE.VTU"}).exit_code, 0);
+  const std::string png = dir + "/p.png";
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"render", dir + "/cube.obj", "--field", "von_mises", "-o", png},
+       "--field colours a mesh or solution (.vtu) by one of its arrays, but '" + dir +
+           "/cube.obj' is a surface, which has none"},
+      {{"render", dir + "/CUBE.VTU", "--max", "10", "-o", png},
+       "--max caps the colour scale of --field, and no --field is given"},
+      {{"render", dir + "/CUBE.VTU", "--units", "m", "-o", png}, "--units gives the unit of a surface input"},
+      {{"render", dir + "/cube.msh", "-o", png},
+       "unknown extension '.msh'; render reads a surface (.stl, .obj, .ply, .off, .vtp) or a hex mesh"},
+      {{"render", dir + "/CUBE.VTU", "--field", "no_such", "-o", png}, "no point or cell array 'no_such'"},
+      {{"render", dir + "/CUBE.VTU", "--field", "scaled_jacobian", "--max", "nan", "-o", png},
+       "--max: nan is out of range: give a number greater than 0"},
+      {{"render", dir + "/CUBE.VTU", "--field", "scaled_jacobian", "--max", "inf", "-o", png},
+       "--max: inf is out of range: give a number greater than 0"},
+      {{"render", dir + "/CUBE.VTU", "--field", "scaled_jacobian", "--max", "0", "-o", png},
+       "--max: 0 is out of range"},
+      // Counts: "Value abc not in range 64 to 8192" before, and the same of 1e4.
+      {{"render", dir + "/cube.obj", "--width", "abc", "-o", png},
+       "--width: abc is not a number: give a whole number from 64 to 8,192"},
+      {{"render", dir + "/cube.obj", "--height", "1e4", "-o", png}, "--height: 1e4 is out of range"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[1] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(png));
+}
+
+// A picture that cannot be written (/proc takes no new files, also for root): one line with VTK's reason.
+// Before: VTK's coloured log ("Unable to open file ...", then "Ran out of disk space") and then only
+// "cannot write '/proc/...png'".
+TEST(Render, AnUnwritablePictureIsOneCleanError) {
+  const std::string dir = temp_dir();
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  const std::string png = "/proc/hexbite_no_such_picture.png";
+  EXPECT_EQ(
+      run_with_prefix(display_prefix(), "render '" + dir + "/cube.obj' -o " + png + " --width 64 --height 64",
+                      dir + "/log"),
+      1);
+  const std::string log = read_file(dir + "/log");
+  EXPECT_NE(log.find("hexbite: failed: cannot write '" + png + "': Unable to open file"), std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("\x1b["), std::string::npos) << log;  // no terminal colour codes
+  EXPECT_EQ(log.find("disk space"), std::string::npos) << log;
+}
+
 TEST(Render, WithoutDisplayFailsClearlyAndWritesNothing) {
   const std::string dir = temp_dir();
   ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--voxel", "1.5"}).exit_code,

@@ -348,6 +348,13 @@ TEST(SurfaceCleanCli, BadOptionsExitTwo) {
   expect_refused({"--target-triangles", "-1"}, jaw, "--target-triangles: -1 is out of range");
   expect_refused({"--target-triangles", "2.5"}, jaw, "not a whole number");
   expect_refused({"--units", "inch"}, jaw, "inch");
+  // Checked while parsing, with the range: "Could not convert: --min-angle = abc" before, and "(got
+  // 45.000000)" for a value out of range.
+  expect_refused({"--min-angle", "abc"}, jaw, "--min-angle: abc is not a number: give a number from 0 to 30");
+  expect_refused({"--min-angle", "45"}, jaw, "--min-angle: 45 is out of range: give a number from 0 to 30");
+  expect_refused({"--max-deviation", "1mm"}, jaw,
+                 "--max-deviation: 1mm is not a number: give a number greater than 0 (a distance in mm)");
+  expect_refused({"--max-deviation", "inf"}, jaw, "--max-deviation: inf is out of range");
 }
 
 TEST(SurfaceCleanCli, OpenSurfaceExitsTwo) {

@@ -203,6 +203,15 @@ TEST(SurfaceIo, AsciiStl) {
   const std::string path = temp_dir() + "/ascii.stl";
   write_file(path, text);
   expect_same_geometry(cube, read_surface(path), path);
+  // A solid named in UTF-8 is still text: it was read as a corrupt binary STL ("its header announces
+  // 170926128 triangles").
+  const std::string named = temp_dir() + "/named.stl";
+  const std::string name =
+      "Unterkiefer_r\xc3\xa4"  // a-umlaut
+      "chts";
+  write_file(named, "solid " + name + text.substr(text.find('\n'), text.rfind("endsolid") - text.find('\n')) +
+                        "endsolid " + name + "\n");
+  expect_same_geometry(cube, read_surface(named), named);
 }
 
 // Unit cube corners: vertex i has x = bit 0, y = bit 1, z = bit 2; faces as outward quads.
@@ -382,6 +391,9 @@ TEST(SurfaceIoErrors, MalformedLines) {
   expect_input_error([&] { read_surface(dir + "/e.stl"); }, {"ends inside the facet that starts at line 2"});
   write_file(dir + "/f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n");
   expect_input_error([&] { read_surface(dir + "/f.off"); }, {"vertex 2 of 3", "cut off"});
+  // A vertex count beyond memory in a damaged header: std::bad_alloc (exit 1, no file named) before.
+  write_file(dir + "/f2.off", "OFF\n2000000000 1 0\n0 0 0\n");
+  expect_input_error([&] { read_surface(dir + "/f2.off"); }, {"f2.off", "vertex 1 of 2000000000", "cut off"});
   write_file(dir + "/g.off", "PFF\n3 1 0\n");
   expect_input_error([&] { read_surface(dir + "/g.off"); }, {"line 1", "keyword OFF"});
   write_file(dir + "/h.ply", "not a ply file\n");
