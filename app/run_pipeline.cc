@@ -517,18 +517,20 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
   const HexMesh& mesh = r.mesh;
   std::vector<std::vector<HeldPoint>> held(bodies.count);
   for (std::size_t i = 0; i < s.supports.size(); ++i) {
-    const MeshPatch& patch = r.support_patches[i];
-    std::vector<double> body_area(bodies.count, 0.0);  // a patch may reach over several bodies
-    for (const BoundaryQuad& quad : patch.faces)
-      body_area[bodies.of_vertex[quad[0]]] += patch_area(mesh, {quad});
-    for (const BoundaryQuad& quad : patch.faces) {
+    std::vector<std::size_t> first(bodies.count);  // a patch may reach over several bodies
+    std::vector<double> area(bodies.count, 0.0);
+    for (int b = 0; b < bodies.count; ++b) first[b] = held[b].size();
+    for (const BoundaryQuad& quad : r.support_patches[i].faces) {
       const int body = bodies.of_vertex[quad[0]];
       for_each_gauss_point(mesh, quad, [&](const std::array<double, 4>& N, double da) {
         Vec3 x{0, 0, 0};
         for (int a = 0; a < 4; ++a) x = vec3::add(x, vec3::scale(mesh.vertices[quad[a]], N[a]));
-        held[body].push_back({x, da / body_area[body], held_components(s.supports[i])});
+        held[body].push_back({x, da, held_components(s.supports[i])});
+        area[body] += da;
       });
     }
+    for (int b = 0; b < bodies.count; ++b)  // each support's weights sum to 1 on each body
+      for (std::size_t k = first[b]; k < held[b].size(); ++k) held[b][k].weight /= area[b];
   }
   std::vector<std::vector<BodyPoint>> volume(bodies.count);
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
