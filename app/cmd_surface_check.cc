@@ -151,7 +151,7 @@ void run_check(const CheckOptions& o) {
   const std::string size_warning = implausible_size_warning(
       std::max({report.bbox_max[0] - report.bbox_min[0], report.bbox_max[1] - report.bbox_min[1],
                 report.bbox_max[2] - report.bbox_min[2]}),
-      "give --units m");
+      o.units, "give --units <unit>");
   if (!size_warning.empty()) std::cerr << "hexbite: warning: '" << o.file << "': " << size_warning << '\n';
 
   if (!report.usable()) {

@@ -65,7 +65,7 @@ void run_from_ct(const FromCtArgs& args) {
   info("wrote " + args.output);
   // A volume whose spacing is in metres gives a bone a thousand times too small.
   const std::string size_warning = implausible_size_warning(
-      largest_extent(surface),
+      largest_extent(surface), "mm",
       "give the volume its spacing in millimetres (MetaImage has no unit of its own)");
   if (!size_warning.empty())
     std::fprintf(stderr, "hexbite: warning: '%s': %s.\n", args.volume.c_str(), size_warning.c_str());

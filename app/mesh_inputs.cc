@@ -15,7 +15,8 @@ TriSurface load_surface_input(const std::string& surface_file, const std::string
   TriSurface surface = load_closed_surface(surface_file, unit_to_mm(units));
   // The result would come out fine, but in the wrong unit every later number (and the solver's) is off by
   // 1000.
-  const std::string size_warning = implausible_size_warning(largest_extent(surface), "give --units m");
+  const std::string size_warning =
+      implausible_size_warning(largest_extent(surface), units, "give --units <unit>");
   if (!size_warning.empty())
     std::cerr << "hexbite: warning: '" << surface_file << "': " << size_warning << '\n';
   return surface;

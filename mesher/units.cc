@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "common/error.h"
 
@@ -14,48 +15,54 @@ double unit_to_mm(const std::string& unit) {
   throw InputError("unknown length unit '" + unit + "': use one of mm, cm, m");
 }
 
-std::string implausible_size_warning(double largest_extent_mm, const std::string& fix) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%.4g mm", largest_extent_mm);
-  if (largest_extent_mm < 0.5)
-    return "the surface is only " + std::string(buf) +
-           " across (the largest side of its bounding box) with lengths read as millimetres; a mandible "
-           "is about 100 mm. If the file's coordinates are in metres, " +
-           fix;
-  if (largest_extent_mm > 3000)
-    return "the surface is " + std::string(buf) +
-           " across (the largest side of its bounding box); a mandible is about 100 mm. If the file's "
-           "coordinates are in micrometres, scale it to millimetres first";
-  return {};
-}
+namespace {
 
-std::string unit_mismatch_warning(double largest_extent_mm, const std::string& unit, const std::string& how) {
-  constexpr double kSmallest = 20.0, kLargest = 500.0;  // mm; a mandible is about 100 mm across
-  if (!(largest_extent_mm < kSmallest || largest_extent_mm > kLargest)) return {};
+// The shared sentence of the two size warnings: the size as read, and the unit among mm, cm and m whose
+// reading of the file comes nearest to 100 mm (by ratio) within [lo, hi] mm, with `how` to give it ("<unit>"
+// in it is replaced by the unit). Empty when the size is within [lo, hi]. `say_only`: "only N mm across"
+// for a size under lo (the wording of the wide bounds' warning, kept as users' scripts match it).
+std::string size_warning(double largest_extent_mm, const std::string& unit, double lo, double hi,
+                         bool say_only, const std::string& how) {
+  if (!(largest_extent_mm < lo || largest_extent_mm > hi)) return {};
   const double in_file_units = largest_extent_mm / unit_to_mm(unit);
-  // The unit whose reading of the file comes nearest to 100 mm (by ratio), if it is plausible.
   std::string best;
   double best_size = 0;
   for (const char* candidate : {"mm", "cm", "m"}) {
     const double size = in_file_units * unit_to_mm(candidate);
-    if (size < kSmallest || size > kLargest) continue;
+    if (size < lo || size > hi) continue;
     if (best.empty() || std::abs(std::log(size / 100.0)) < std::abs(std::log(best_size / 100.0)))
       best = candidate, best_size = size;
   }
   char text[400];
   std::snprintf(text, sizeof text,
-                "the surface is %.4g mm across (the largest side of its bounding box) with its coordinates "
+                "the surface is %s%.4g mm across (the largest side of its bounding box) with its coordinates "
                 "read as %s; a mandible is about 100 mm",
-                largest_extent_mm, unit.c_str());
-  if (best.empty())
-    return std::string(text) + ", and no unit of mm, cm or m gives a size between 20 and 500 mm: scale the " +
-           "file to millimetres first";
+                say_only && largest_extent_mm < lo ? "only " : "", largest_extent_mm, unit.c_str());
+  if (best.empty()) {
+    std::snprintf(text + std::strlen(text), sizeof text - std::strlen(text),
+                  ", and no unit of mm, cm or m gives a size between %g and %g mm: scale the file to "
+                  "millimetres first",
+                  lo, hi);
+    return text;
+  }
   std::string fix = how;
   for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
     fix.replace(at, 6, best);
   char size[64];
   std::snprintf(size, sizeof size, "%.4g mm", best_size);
   return std::string(text) + ". If the file's coordinates are in " + best + " (" + size + " across), " + fix;
+}
+
+}  // namespace
+
+std::string implausible_size_warning(double largest_extent_mm, const std::string& unit,
+                                     const std::string& how) {
+  return size_warning(largest_extent_mm, unit, 0.5, 3000.0, true, how);
+}
+
+std::string unit_mismatch_warning(double largest_extent_mm, const std::string& unit, const std::string& how) {
+  // A mandible is about 100 mm across.
+  return size_warning(largest_extent_mm, unit, 20.0, 500.0, false, how);
 }
 
 std::string format_point_mm(const Vec3& p) {

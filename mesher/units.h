@@ -16,11 +16,15 @@ constexpr double kMaxCoordinateMm = 1e6;
 // Throws InputError naming the accepted units for anything else.
 double unit_to_mm(const std::string& unit);
 
-// A sentence for a warning when a bone's size in millimetres (the largest side of its bounding
-// box, after the unit conversion) says the unit was probably wrong: under 0.5 mm (a bone exported
-// in metres and read as mm; `fix` says how to give the unit) or over 3000 mm (micrometres).
-// Empty for plausible sizes.
-std::string implausible_size_warning(double largest_extent_mm, const std::string& fix);
+// A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m) has a size
+// no bone has: its largest side, `largest_extent_mm` after the conversion, under 0.5 mm (a bone exported in
+// metres and read as mm) or over 3000 mm (one in mm read as metres, or in micrometres). Names the unit among
+// mm, cm and m that would give a size nearest 100 mm within those bounds, and `how` to give it (e.g. "give
+// --units <unit>"; "<unit>" in it is replaced by the unit), or says that none does. Empty for plausible
+// sizes. (The commands that mesh any solid use these wide bounds; `hexbite run` uses
+// unit_mismatch_warning's mandible bounds.)
+std::string implausible_size_warning(double largest_extent_mm, const std::string& unit,
+                                     const std::string& how);
 
 // A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m) is
 // implausibly sized for a mandible: its largest side, `largest_extent_mm` after the conversion, under 20 mm

@@ -176,6 +176,28 @@ TEST(Cli, SurfaceInMetresWithoutUnitsIsWarnedAbout) {
   }
 }
 
+// The other way round: a 100 mm cube read with --units m is 100 m across. The warning used to suggest
+// micrometres whatever the unit given; it names the unit that gives a plausible size instead.
+TEST(Cli, SurfaceInMillimetresReadAsMetresIsToldToUseMillimetres) {
+  std::string mm;
+  for (int v = 0; v < 8; ++v)
+    mm += "v " + std::to_string(100 * (v & 1)) + " " + std::to_string(100 * ((v >> 1) & 1)) + " " +
+          std::to_string(100 * ((v >> 2) & 1)) + "\n";
+  for (const char* f : kCubeFaces) mm += f;
+  const std::string path = write_case("mm.obj", mm);
+  auto r = run_hexbite({"surface", "check", path, "--units", "m"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: '" + path +
+                       "': the surface is 1e+05 mm across (the largest side of its bounding box) with its "
+                       "coordinates read as m; a mandible is about 100 mm. If the file's coordinates are in "
+                       "mm (100 mm across), give --units mm"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("micrometres"), std::string::npos) << r.err;
+  r = run_hexbite({"surface", "check", path});
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
 TEST(Cli, RepairedSurfaceIsWrittenInMillimetres) {
   // An inward cube in cm: flipped, scaled to mm and written; the written file checks clean.
   std::string inward = kCubeVertices;
