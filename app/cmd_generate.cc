@@ -5,13 +5,16 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "app/commands.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/output_stage.h"
 #include "common/progress.h"
 #include "mesher/ct_surface.h"
 #include "mesher/landmarks.h"
@@ -46,14 +49,58 @@ double enclosed_volume(const TriSurface& s) {
   return six / 6.0;
 }
 
+// The surface, the landmarks and the CT go to up to three folders of the user's choice. Each file is written
+// into a stage inside its folder (common/output_stage.h), and the stages are moved in only when every file
+// is complete: a write that fails (a full disk, an unwritable folder) leaves none of this run's files, and
+// the earlier ones untouched. Before, a failed CT write left the new surface beside an old CT. The moves of
+// two folders are not one transaction, but the moves are renames of paths checked while parsing; the
+// writes, where disks fill up, are all done before the first of them.
+class GenerateOutputs {
+ public:
+  // Calls write(path in the stage of `path`'s folder); an error names the file by `path`.
+  void write(const std::string& path, const std::function<void(const std::string&)>& write) {
+    const fs::path target(path);
+    const std::string dir = target.has_parent_path() ? target.parent_path().string() : ".";
+    auto it = std::find_if(stages_.begin(), stages_.end(),
+                           [&](const std::unique_ptr<OutputStage>& s) { return s->dir() == dir; });
+    if (it == stages_.end()) {
+      stages_.push_back(std::make_unique<OutputStage>(dir));  // throws naming `dir`
+      it = std::prev(stages_.end());
+    }
+    const OutputStage& stage = **it;
+    const std::string kept = "; none of the outputs was written (files of those names are as they were)";
+    try {
+      write(stage.stage_dir() + "/" + target.filename().string());
+    } catch (const InputError& e) {
+      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+    } catch (const std::exception& e) {
+      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+    }
+  }
+
+  // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself).
+  void commit() {
+    for (const std::unique_ptr<OutputStage>& stage : stages_) {
+      std::vector<std::string> files;
+      for (const fs::directory_entry& entry : fs::directory_iterator(stage->stage_dir()))
+        if (entry.is_regular_file()) files.push_back(entry.path().filename().string());
+      std::sort(files.begin(), files.end());
+      stage->commit(files);
+    }
+  }
+
+ private:
+  std::vector<std::unique_ptr<OutputStage>> stages_;  // one per output folder; uncommitted ones discarded
+};
+
 void run_generate(const GenerateArgs& args) {
   MandibleParameters params = args.parameters;
   params.variant = parse_variant(args.variant);
   params = complete_parameters(params);
   const std::string landmark_path =
       args.landmarks.empty() ? default_landmark_path(args.output) : args.landmarks;
-  // Every output path was checked while parsing (app/option_checks.h), so a mistake in one of them never
-  // leaves the others written; the default landmark path shares the checked output's folder.
+  // Every output path was checked while parsing (app/option_checks.h), so a mistake in one of them is found
+  // before any work; the default landmark path shares the checked output's folder.
 
   const auto start = std::chrono::steady_clock::now();
   Progress progress("generate mandible");
@@ -61,9 +108,13 @@ void run_generate(const GenerateArgs& args) {
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  write_surface(args.output, jaw.surface);
-  write_landmarks(landmark_path, jaw.landmarks, mandible_landmark_header(params));
-  if (!args.ct.empty()) write_volume(args.ct, jaw.ct);
+  GenerateOutputs outputs;
+  outputs.write(args.output, [&](const std::string& p) { write_surface(p, jaw.surface); });
+  outputs.write(landmark_path, [&](const std::string& p) {
+    write_landmarks(p, jaw.landmarks, mandible_landmark_header(params));
+  });
+  if (!args.ct.empty()) outputs.write(args.ct, [&](const std::string& p) { write_volume(p, jaw.ct); });
+  outputs.commit();
 
   Vec3 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
           std::numeric_limits<double>::max()};

@@ -378,14 +378,6 @@ void broadcast(std::string* text, int root) {
   MPI_Bcast(text->data(), static_cast<int>(size), MPI_CHAR, root, MPI_COMM_WORLD);
 }
 
-// `text` with every `from` replaced by `to`.
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  if (from.empty()) return text;
-  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
-    text.replace(at, from.size(), to);
-  return text;
-}
-
 }  // namespace
 
 RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
@@ -437,7 +429,7 @@ void RunOutputs::on_all_ranks(const std::function<void()>& step, Note note) {
     broadcast(&message, first);
   }
   if (kind == 0) return;
-  message = replaced(message, stage_dir_, dir_);
+  message = named_in_dir(message, stage_dir_, dir_);
   if (note != kNoNote)
     message +=
         "; the run kept none of its files and " +

@@ -125,4 +125,12 @@ void OutputStage::commit(const std::vector<std::string>& files,
   fs::remove_all(stage_, ec);
 }
 
+std::string named_in_dir(std::string message, const std::string& stage_dir, const std::string& dir) {
+  if (stage_dir.empty()) return message;
+  for (std::size_t at = message.find(stage_dir); at != std::string::npos;
+       at = message.find(stage_dir, at + dir.size()))
+    message.replace(at, stage_dir.size(), dir);
+  return message;
+}
+
 }  // namespace hexbite

@@ -55,4 +55,8 @@ class OutputStage {
   bool done_ = false;                           // committed or discarded
 };
 
+// A writer's `message` names a file by its place in the stage `stage_dir`; this names it by its place in
+// `dir`, where the user looks for it.
+std::string named_in_dir(std::string message, const std::string& stage_dir, const std::string& dir);
+
 }  // namespace hexbite

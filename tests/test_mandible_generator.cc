@@ -667,6 +667,30 @@ TEST(Cli, GenerateRejectsBadOptionsWithoutWritingAnything) {
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
+// The outputs of generate are one set: a write that fails leaves none of them, and earlier files of those
+// names as they were. Before, a CT that could not be written (here into /proc, which takes no new files,
+// also for root) left the new surface and landmarks beside the old CT, exit 1; and a surface that did not
+// fit on the disk (a 500 kB file-size limit, SIGXFSZ ignored so that the write fails as on a full disk)
+// must be named by its own path, not by the stage it is written into.
+TEST(Cli, GenerateWritesAllItsOutputsOrNone) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/jaw.stl", "an earlier surface");
+  const std::map<std::string, std::string> before = test::files_under(dir);
+  auto r = test::run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--landmarks",
+                              dir + "/jaw.yaml", "--ct", "/proc/hexbite_no_such_ct.mha"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write in the output folder '/proc'"), std::string::npos) << r.err;
+  test::expect_same_files(before, test::files_under(dir));
+
+  r = test::run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--ct", dir + "/jaw.mha"},
+                        {"bash", "-c", "trap '' XFSZ; ulimit -f 500; exec \"$@\"", "bash"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(r.err, "hexbite: failed: cannot write '" + dir +
+                       "/jaw.stl': disk full or not writable; none of the outputs was written (files of "
+                       "those names are as they were)\n");
+  test::expect_same_files(before, test::files_under(dir));
+}
+
 TEST(Cli, SurfaceFromCtBadInputsExitTwoWithoutOutput) {
   const std::string dir = test::temp_dir();
   write_volume(dir + "/jaw.nii.gz", generated(MandibleVariant::kAtrophic).ct);
