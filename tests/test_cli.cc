@@ -34,6 +34,16 @@ std::string cube_obj(int skip_face = -1, const std::string& extra = "") {
   return text + extra;
 }
 
+// The cube with sides of `side` (in the file's unit), for the unit warnings.
+std::string cube_obj_of_side(double side) {
+  std::string text;
+  for (int v = 0; v < 8; ++v)
+    text += "v " + std::to_string(side * (v & 1)) + " " + std::to_string(side * ((v >> 1) & 1)) + " " +
+            std::to_string(side * ((v >> 2) & 1)) + "\n";
+  for (const char* f : kCubeFaces) text += f;
+  return text;
+}
+
 std::string write_case(const std::string& name, const std::string& contents) {
   const std::string path = temp_dir() + "/" + name;
   write_file(path, contents);
@@ -140,12 +150,7 @@ TEST(Cli, TextReportAndQuiet) {
 // A 20 mm cube exported in metres and read without --units is a usable 0.02 mm cube: nothing in the
 // report was wrong, but every later length, stress and volume would be off by 1000. Warned about.
 TEST(Cli, SurfaceInMetresWithoutUnitsIsWarnedAbout) {
-  std::string metres;
-  for (int v = 0; v < 8; ++v)
-    metres += "v " + std::to_string(0.02 * (v & 1)) + " " + std::to_string(0.02 * ((v >> 1) & 1)) + " " +
-              std::to_string(0.02 * ((v >> 2) & 1)) + "\n";
-  for (const char* f : kCubeFaces) metres += f;
-  const std::string path = write_case("metres.obj", metres);
+  const std::string path = write_case("metres.obj", cube_obj_of_side(0.02));
   auto r = run_hexbite({"surface", "check", path});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("hexbite: warning: '" + path + "': the surface is only 0.02 mm across"),
@@ -179,12 +184,7 @@ TEST(Cli, SurfaceInMetresWithoutUnitsIsWarnedAbout) {
 // The other way round: a 100 mm cube read with --units m is 100 m across. The warning used to suggest
 // micrometres whatever the unit given; it names the unit that gives a plausible size instead.
 TEST(Cli, SurfaceInMillimetresReadAsMetresIsToldToUseMillimetres) {
-  std::string mm;
-  for (int v = 0; v < 8; ++v)
-    mm += "v " + std::to_string(100 * (v & 1)) + " " + std::to_string(100 * ((v >> 1) & 1)) + " " +
-          std::to_string(100 * ((v >> 2) & 1)) + "\n";
-  for (const char* f : kCubeFaces) mm += f;
-  const std::string path = write_case("mm.obj", mm);
+  const std::string path = write_case("mm.obj", cube_obj_of_side(100));
   auto r = run_hexbite({"surface", "check", path, "--units", "m"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("hexbite: warning: '" + path +
