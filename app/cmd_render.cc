@@ -19,15 +19,16 @@ namespace {
 
 // Options that the input would ignore are refused before anything is read (as `mesh` refuses its own):
 // `--field` and `--max` colour a mesh's arrays, which a surface has none of; `--units` scales a surface, and
-// a .vtu is read in mm. Returns whether the input is a mesh (a .vtu, in any case).
+// a .vtu is read in mm. Returns whether the input is a mesh (a .vtu, or the .pvtu of a run under mpirun, in
+// any case).
 bool check_render_input(const std::string& input, bool field, bool max, bool units) {
   const std::string ext = lower_extension(input);
-  const bool mesh = ext == ".vtu";
+  const bool mesh = ext == ".vtu" || ext == ".pvtu";
   if (!mesh && ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".vtp")
     throw InputError("cannot render '" + input +
                      "': " + (ext.empty() ? std::string("no extension") : "unknown extension '" + ext + "'") +
                      "; render reads a surface (.stl, .obj, .ply, .off, .vtp) or a hex mesh or solution "
-                     "(.vtu), in any case");
+                     "(.vtu, or .pvtu with its pieces), in any case");
   if (!mesh && field)
     throw InputError("--field colours a mesh or solution (.vtu) by one of its arrays, but '" + input +
                      "' is a surface, which has none: drop --field, or render the .vtu");

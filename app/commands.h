@@ -19,5 +19,6 @@ void add_refine_command(CLI::App& app);     // refine MESH.vtu --surface SURFACE
 void add_reorder_command(CLI::App& app);    // reorder MESH.vtu -o out.vtu --method bfs|rcm, cmd_reorder.cc
 void add_run_command(CLI::App& app);        // run SCENARIO.yaml -o DIR [--export inp], cmd_run.cc
 void add_quad_commands(CLI::App& app);      // the "quad" group (quad check Q.obj), cmd_quad.cc
+void add_report_command(CLI::App& app);     // report RUN_DIR -o report.html, cmd_report.cc
 
 }  // namespace hexbite

@@ -151,6 +151,7 @@ int main(int argc, char** argv) {
   hexbite::add_reorder_command(app);
   hexbite::add_run_command(app);
   hexbite::add_quad_commands(app);
+  hexbite::add_report_command(app);
 
   try {
     app.parse(argc, argv);

@@ -21,6 +21,8 @@
 #include <vtkTextProperty.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkWindowToImageFilter.h>
+#include <vtkXMLPUnstructuredGridReader.h>
+#include <vtkXMLReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <cstdlib>
@@ -28,6 +30,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/paths.h"
 #include "mesher/vtk_messages.h"
 
 namespace hexbite {
@@ -159,18 +162,26 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
                      const RenderOptions& options) {
   if (!std::filesystem::is_regular_file(vtu_path))
     throw InputError("cannot read '" + vtu_path + "': no such file");
-  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  // A .pvtu (the pieces of a run under mpirun) is read whole: its pieces appended into one grid. The nodes
+  // that pieces share appear once per piece, so the faces between pieces count as outer faces too; they
+  // lie inside the bone and are hidden in the picture.
+  const bool pieces = lower_extension(vtu_path) == ".pvtu";
+  vtkSmartPointer<vtkXMLReader> reader;
+  if (pieces)
+    reader = vtkSmartPointer<vtkXMLPUnstructuredGridReader>::New();
+  else
+    reader = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
   vtkUnstructuredGrid* grid = nullptr;
   {
     VtkMessageCapture capture;
     if (reader->CanReadFile(vtu_path.c_str()) != 0) {
       reader->SetFileName(vtu_path.c_str());
       update_xml_reader(reader, vtu_path);
-      grid = reader->GetOutput();
+      grid = vtkUnstructuredGrid::SafeDownCast(reader->GetOutputDataObject(0));
     }
     if (!capture.errors().empty() || grid == nullptr || grid->GetNumberOfCells() == 0)
-      throw InputError("cannot read '" + vtu_path + "' as a VTK unstructured grid (.vtu) with cells" +
-                       capture.reason());
+      throw InputError("cannot read '" + vtu_path + "' as a VTK unstructured grid (" +
+                       (pieces ? ".pvtu and its pieces" : ".vtu") + ") with cells" + capture.reason());
   }
 
   vtkNew<vtkDataSetSurfaceFilter> outer;  // only the boundary faces are visible

@@ -1,0 +1,96 @@
+// `hexbite report RUN_DIR -o report.html`: the validation report of a finished `hexbite run` as one
+// self-contained HTML file (postprocess/run_report.h), with pictures of the solution unless --no-pictures.
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.h"
+#include "app/option_checks.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/progress.h"
+#include "postprocess/render.h"
+#include "postprocess/report_pictures.h"
+#include "postprocess/run_report.h"
+#include "postprocess/run_results.h"
+
+namespace hexbite {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ReportArgs {
+  std::string run_dir, output, title;
+  bool no_pictures = false, json = false;
+};
+
+// The coarse level's solution of RUN_DIR, which the pictures are drawn from: solution.vtu, or under mpirun
+// solution.pvtu with its pieces. A scenario with outputs.vtu: false writes neither, which is bad input for
+// a report with pictures (exit 2), with what to do.
+std::string solution_for_pictures(const std::string& run_dir) {
+  std::error_code ec;
+  for (const char* name : {"solution.vtu", "solution.pvtu"}) {
+    const std::string path = (fs::path(run_dir) / name).string();
+    if (fs::is_regular_file(path, ec)) return path;
+  }
+  throw InputError("'" + (fs::path(run_dir) / "solution.vtu").string() +
+                   "' does not exist (nor a solution.pvtu of a run under mpirun), and the report's pictures "
+                   "are drawn from it (a scenario with `outputs: {vtu: false}` skips it): add --no-pictures, "
+                   "or run the scenario again with outputs.vtu: true");
+}
+
+void write_report(const ReportArgs& a) {
+  std::error_code ec;
+  if (!fs::exists(a.run_dir, ec))
+    throw InputError("'" + a.run_dir + "' does not exist: give the folder of a finished run " +
+                     "(`hexbite run SCENARIO -o RUN_DIR`)");
+  if (!fs::is_directory(a.run_dir, ec))
+    throw InputError("'" + a.run_dir + "' is a file, not a folder: give the folder of a finished run " +
+                     "(`hexbite run SCENARIO -o RUN_DIR`), which holds results.json");
+  const RunFigures run = read_run_figures((fs::path(a.run_dir) / "results.json").string());
+  std::vector<ReportPicture> pictures;
+  if (!a.no_pictures) {
+    const std::string vtu = solution_for_pictures(a.run_dir);
+    // The same refusal as `hexbite render`, before any work, with the way out that a report has.
+    if (!can_render())
+      throw RunError(
+          "cannot draw the report's pictures: no X display (DISPLAY is not set); run the command "
+          "under `xvfb-run -a`, or add --no-pictures for a report without pictures");
+    pictures = render_report_pictures(vtu, run);
+  }
+  const std::vector<std::string> warnings = report_warnings(run);
+  write_file_atomically(a.output, report_html(run, warnings, pictures, {a.title, HEXBITE_VERSION}));
+  for (const std::string& w : warnings) std::cerr << "hexbite: warning: " << w << '\n';
+  if (a.json) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const ReportPicture& p : pictures) list.push_back({{"field", p.field}, {"view", p.view}});
+    std::cout << nlohmann::json{{"report", a.output}, {"pictures", list}, {"warnings", warnings}}.dump(2)
+              << '\n';
+  }
+  info("wrote " + a.output + " (" + std::to_string(pictures.size()) + " pictures, " +
+       std::to_string(warnings.size()) + (warnings.size() == 1 ? " warning)" : " warnings)"));
+}
+
+}  // namespace
+
+void add_report_command(CLI::App& app) {
+  auto args = std::make_shared<ReportArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "report", "Write the validation report of a finished run as one self-contained HTML file");
+  cmd->add_option("RUN_DIR", args->run_dir, "Output folder of `hexbite run` (holds results.json)")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "HTML file to write")
+      ->required()
+      ->check(output_file({".html", ".htm"}));
+  cmd->add_option("--title", args->title, "Report title (default: the scenario's name)");
+  cmd->add_flag("--no-pictures", args->no_pictures,
+                "Leave out the pictures (they need solution.vtu and an X display)");
+  cmd->add_flag("--json", args->json, "Print a JSON summary: the report's path, its pictures and warnings");
+  cmd->callback([args] { write_report(*args); });
+}
+
+}  // namespace hexbite

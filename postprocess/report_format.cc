@@ -1,0 +1,56 @@
+#include "postprocess/report_format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "common/number_format.h"
+
+namespace hexbite {
+
+std::string format_newtons(double n) {
+  return format_table_number(n, 1, 0);
+}
+
+std::string format_significant_digits(double value, int digits) {
+  if (value == 0) return "0";
+  if (!std::isfinite(value)) return std::isnan(value) ? "n/a" : (value > 0 ? "inf" : "-inf");
+  const int exponent = static_cast<int>(std::floor(std::log10(std::fabs(value))));
+  char text[64];
+  if (exponent < -3 || exponent > 5)
+    std::snprintf(text, sizeof text, "%.*e", digits - 1, value);
+  else
+    std::snprintf(text, sizeof text, "%.*f", std::max(0, digits - 1 - exponent), value);
+  return text;
+}
+
+std::string format_mm(double mm) {
+  return format_significant_digits(mm, 3);
+}
+
+std::string format_mpa(double mpa) {
+  return format_table_number(mpa, std::fabs(mpa) < 100 ? 2 : 1, 0);
+}
+
+std::string format_percent(std::optional<double> fraction) {
+  if (!fraction) return "n/a";
+  const double percent = 100.0 * *fraction;
+  return (percent > 0 ? "+" : "") + format_table_number(percent, 2, 0) + " %";
+}
+
+std::string format_point(const Vec3& p, int decimals) {
+  char text[192];
+  std::snprintf(text, sizeof text, "(%.*f, %.*f, %.*f)", decimals, p[0], decimals, p[1], decimals, p[2]);
+  return text;
+}
+
+std::string format_count(long n) {
+  std::string digits = std::to_string(std::labs(n)), out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return (n < 0 ? "-" : "") + out;
+}
+
+}  // namespace hexbite

@@ -1,0 +1,86 @@
+#include "postprocess/report_pictures.h"
+
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.h"
+#include "postprocess/render.h"
+#include "postprocess/report_format.h"
+
+namespace hexbite {
+
+namespace {
+
+// A fresh folder under the system's temporary folder, removed with everything in it when this goes.
+class TemporaryFolder {
+ public:
+  TemporaryFolder() {
+    std::string name = (std::filesystem::temp_directory_path() / "hexbite-report-XXXXXX").string();
+    if (mkdtemp(name.data()) == nullptr)
+      throw RunError("cannot create a temporary folder for the report's pictures in '" +
+                     std::filesystem::temp_directory_path().string() + "'");
+    path_ = name;
+  }
+  ~TemporaryFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (!in) throw RunError("cannot read the rendered picture '" + path + "'");
+  return bytes.str();
+}
+
+}  // namespace
+
+std::vector<ReportPicture> render_report_pictures(const std::string& solution_vtu, const RunFigures& run) {
+  const LevelFigures& l = run.coarse;
+  // The stress peaks at the edges of fixed patches (a singularity of the exact solution) would leave the
+  // rest of the bone in the lowest colour: the scale stops at the 99th percentile of the per-hex stress.
+  const std::string vm_scale =
+      "Colour scale up to the 99th percentile of the per-hex stress, " + format_mpa(l.von_mises_p99) +
+      " MPa (higher stresses in red); the maximum is " + format_mpa(l.von_mises_max) + " MPa at " +
+      format_point(l.von_mises_max_at) + " mm.";
+  struct Spec {
+    std::string field, view, caption;
+    double colour_max;
+  };
+  const std::vector<Spec> specs = {
+      {"von_mises", "iso", "von Mises stress (MPa) on the outer surface, oblique view. " + vm_scale,
+       l.von_mises_p99},
+      {"von_mises", "side", "von Mises stress (MPa) on the outer surface, seen from the right. " + vm_scale,
+       l.von_mises_p99},
+      {"displacement", "iso",
+       "Displacement magnitude (mm), oblique view (undeformed shape). Colour scale up to the maximum, " +
+           format_mm(l.max_displacement) + " mm at " + format_point(l.max_displacement_at) + " mm.",
+       0.0},
+  };
+  TemporaryFolder folder;
+  std::vector<ReportPicture> pictures;
+  for (const Spec& s : specs) {
+    RenderOptions options;
+    options.view = s.view;
+    options.width = 1200;
+    options.height = 800;
+    options.colour_max = s.colour_max;
+    const std::string png = folder.path() + "/" + s.field + "_" + s.view + ".png";
+    render_mesh_png(solution_vtu, s.field, png, options);
+    pictures.push_back({s.field, s.view, s.caption, read_bytes(png)});
+  }
+  return pictures;
+}
+
+}  // namespace hexbite

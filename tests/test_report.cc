@@ -1,0 +1,334 @@
+// `hexbite report`: the HTML report of a finished run holds results.json's figures as documented
+// (docs/reports.md), escapes the scenario's strings, embeds its pictures as PNG data, warns about weak
+// supports, and refuses bad input with exit 2 before writing anything.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using test::read_file;
+using test::run_hexbite;
+using test::temp_dir;
+using test::write_file;
+
+// A 20 mm cube pulled along x against a clamped face, meshed with a few hundred hexes and refined once.
+// The name has HTML's special characters.
+const std::string kCube = R"(name: "cube <b>& bite"
+geometry:
+  surface: {file: cube.obj}
+mesh: {target_hexes: 300, validation_levels: 1}
+muscles:
+  - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 5, direction: [1, 0, 0], max_force_N: 100}
+supports:
+  - {name: nut, at: [0, 10, 10], radius_mm: 5, bite: true}
+  - {name: floor_rest, at: [10, 10, 0], radius_mm: 4}
+probes:
+  - {name: far_corner, at: [20, 20, 20]}
+)";
+
+// Rendering needs an X display: the caller's, or a virtual one (scripts/test.sh provides one already).
+std::vector<std::string> display_launcher() {
+  return std::getenv("DISPLAY") != nullptr ? std::vector<std::string>{}
+                                           : std::vector<std::string>{"xvfb-run", "-a"};
+}
+
+// `scenario` (text) with the cube next to it, run into DIR/run; returns DIR/run.
+std::string run_cube(const std::string& scenario, const std::vector<std::string>& extra = {}) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/cube.obj", test::cubes_obj(1));
+  write_file(dir + "/cube.yaml", scenario);
+  std::vector<std::string> args = {"-q", "run", dir + "/cube.yaml", "-o", dir + "/run"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const test::CommandResult r = run_hexbite(args);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return dir + "/run";
+}
+
+// The part of `html` from the heading that starts with `heading` to the next heading.
+std::string section(const std::string& html, const std::string& heading) {
+  const std::size_t from = html.find("<h2>" + heading);
+  if (from == std::string::npos) return "";
+  return html.substr(from, html.find("<h2>", from + 4) - from);
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+std::string printf_number(const char* format, double v) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+
+std::string base64_decode(const std::string& text) {
+  static const std::string kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  unsigned long group = 0;
+  int bits = 0;
+  for (char c : text) {
+    const std::size_t d = kDigits.find(c);
+    if (d == std::string::npos) break;  // '=' padding
+    group = (group << 6) | d;
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += static_cast<char>((group >> bits) & 0xff);
+    }
+  }
+  return out;
+}
+
+// Nothing a printed or mailed report would have to fetch or run.
+void expect_self_contained(const std::string& html) {
+  for (const char* external : {"http://", "https://", "src=\"file", "<script", "<link"})
+    EXPECT_EQ(html.find(external), std::string::npos) << external;
+}
+
+class Report : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    run_dir_ = new std::string(run_cube(kCube));
+    results_ = new json(json::parse(read_file(*run_dir_ + "/results.json")));
+  }
+  static std::string* run_dir_;
+  static json* results_;
+};
+std::string* Report::run_dir_ = nullptr;
+json* Report::results_ = nullptr;
+
+TEST_F(Report, HoldsTheFiguresOfResultsJsonFormattedAsDocumented) {
+  const json& r = *results_;
+  const std::string out = temp_dir() + "/report.html";
+  const test::CommandResult c = run_hexbite({"report", *run_dir_, "-o", out, "--no-pictures"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const std::string html = read_file(out);
+  expect_self_contained(html);
+
+  // The bite force with 1 decimal in its cell; the same cell with a number 0.1 N off is not there, so the
+  // check tells a wrong figure from the right one.
+  const double bite = r["bite_force_N"].get<double>();
+  const std::string results = section(html, "Results");
+  EXPECT_NE(results.find(">" + printf_number("%.1f", bite) + "<"), std::string::npos) << results;
+  EXPECT_EQ(results.find(">" + printf_number("%.1f", bite + 0.1) + "<"), std::string::npos) << results;
+  for (const auto& [name, reaction] : r["reactions"].items()) {
+    EXPECT_NE(results.find("<td>" + name + "</td>"), std::string::npos) << name;
+    EXPECT_NE(results.find(">" + printf_number("%.1f", reaction["magnitude_N"].get<double>()) + "<"),
+              std::string::npos)
+        << name;
+  }
+
+  // One row per level (and the header), with each level's bite force.
+  const std::string validation = section(html, "Validation");
+  const json& levels = r["validation"]["levels"];
+  ASSERT_EQ(levels.size(), 2u);
+  EXPECT_EQ(count(validation, "<tr>"), levels.size() + 1) << validation;
+  for (const json& l : levels)
+    EXPECT_NE(validation.find(">" + printf_number("%.1f", l["bite_force_N"].get<double>()) + "<"),
+              std::string::npos)
+        << validation;
+  // The relative change between the two levels in percent with 2 decimals, as results.json has it.
+  const double change = r["validation"]["relative_change"]["bite_force"].get<double>();
+  EXPECT_NE(
+      validation.find(">" + std::string(change > 0 ? "+" : "") + printf_number("%.2f", 100 * change) + " %<"),
+      std::string::npos)
+      << validation;
+
+  // The quality table's minima (scaled Jacobian 3 decimals, condition number and Oddy 2).
+  const std::string quality = section(html, "Mesh quality");
+  const json& q = r["mesh"]["quality"];
+  EXPECT_NE(quality.find(">" + printf_number("%.3f", q["scaled_jacobian"]["min"].get<double>()) + "<"),
+            std::string::npos)
+      << quality;
+  EXPECT_EQ(
+      quality.find(">" + printf_number("%.3f", q["scaled_jacobian"]["min"].get<double>() + 0.001) + "<"),
+      std::string::npos);
+  EXPECT_NE(quality.find(">" + printf_number("%.2f", q["condition"]["min"].get<double>()) + "<"),
+            std::string::npos)
+      << quality;
+  EXPECT_NE(quality.find(">" + printf_number("%.2f", q["oddy"]["min"].get<double>()) + "<"),
+            std::string::npos)
+      << quality;
+  EXPECT_NE(section(html, "Probes").find("<td>far_corner</td>"), std::string::npos);
+  EXPECT_NE(section(html, "Pictures").find("no pictures"), std::string::npos);
+
+  // The scenario's name escaped, in the title and the heading; never as markup.
+  EXPECT_NE(html.find("<h1>cube &lt;b&gt;&amp; bite</h1>"), std::string::npos);
+  EXPECT_EQ(html.find("<b>&"), std::string::npos);
+}
+
+TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
+  const std::string dir = temp_dir(), tmp = dir + "/tmp";
+  fs::create_directories(tmp);
+  // The pictures are rendered into a temporary folder under TMPDIR (after xvfb-run, which has its own).
+  std::vector<std::string> launcher = display_launcher();
+  launcher.insert(launcher.end(), {"env", "TMPDIR=" + tmp});
+  const test::CommandResult c = run_hexbite(
+      {"report", *run_dir_, "-o", dir + "/r.htm", "--title", "Cube & <i>nut</i>", "--json"}, launcher);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const json summary = json::parse(c.out);
+  EXPECT_EQ(summary["report"], dir + "/r.htm");
+  EXPECT_EQ(summary["pictures"].size(), 3u) << summary.dump();
+  EXPECT_TRUE(summary["warnings"].is_array());
+
+  const std::string html = read_file(dir + "/r.htm");
+  expect_self_contained(html);
+  EXPECT_NE(html.find("<h1>Cube &amp; &lt;i&gt;nut&lt;/i&gt;</h1>"), std::string::npos);
+  // (std::regex would recurse once per character of a picture's 300 kB and overflow the stack.)
+  const std::string prefix = "src=\"data:image/png;base64,";
+  int pictures = 0;
+  for (std::size_t at = html.find(prefix); at != std::string::npos; at = html.find(prefix, at + 1)) {
+    const std::size_t from = at + prefix.size();
+    const std::string png = base64_decode(html.substr(from, html.find('"', from) - from));
+    EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+    EXPECT_GT(png.size(), 1000u);
+    ++pictures;
+  }
+  EXPECT_EQ(pictures, 3);
+  // Each caption gives its field's maximum, as the results table does.
+  const std::string captions = section(html, "Pictures");
+  EXPECT_NE(captions.find("the maximum is " +
+                          printf_number("%.2f", (*results_)["von_mises_max_MPa"].get<double>()) + " MPa"),
+            std::string::npos)
+      << captions;
+  EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
+}
+
+// Supports that leave a rotation to the extent of their patches (as in tests/test_run.cc, on the cube): a
+// bite patch on the top face fixed in z and a "condyle" patch on it fixed in x and y let the cube turn
+// about the axis along y through the bite. The report says so first.
+TEST(ReportWarnings, WeakSupportsAreWarnedAboutFirst) {
+  std::string text = kCube;
+  text.replace(text.find("validation_levels: 1"), 20, "validation_levels: 0");
+  text.replace(text.find("supports:"), std::string::npos,
+               "supports:\n"
+               "  - {name: nut, at: [18, 10, 20], radius_mm: 3, fixed: [z], bite: true}\n"
+               "  - {name: condyle, at: [2, 10, 20], radius_mm: 3, fixed: [x, y]}\n");
+  const std::string run = run_cube(text);
+  const json hold = json::parse(read_file(run + "/results.json"))["support_hold"][0];
+  ASSERT_TRUE(hold["weak"].get<bool>()) << hold.dump();
+  const std::string out = temp_dir() + "/weak.html";
+  const test::CommandResult c = run_hexbite({"-q", "report", run, "-o", out, "--no-pictures", "--json"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const json summary = json::parse(c.out);
+  ASSERT_GE(summary["warnings"].size(), 1u) << summary.dump();
+  EXPECT_NE(summary["warnings"][0].get<std::string>().find("Weak supports"), std::string::npos);
+  const std::string html = read_file(out);
+  const std::string warnings = section(html, "Warnings");
+  EXPECT_NE(warnings.find("against a rotation about the axis through"), std::string::npos) << warnings;
+  EXPECT_LT(html.find("<h2>Warnings"), html.find("<h2>Results"));
+  EXPECT_NE(c.err.find("hexbite: warning: Weak supports"), std::string::npos) << c.err;
+}
+
+TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
+  const std::string dir = temp_dir(), out = dir + "/r.html";
+  const std::string results = read_file(*run_dir_ + "/results.json");
+  // A run folder holding `text` as results.json (and no solution).
+  const auto folder_with = [&](const std::string& name, const std::string& text) {
+    fs::create_directories(dir + "/" + name);
+    write_file(dir + "/" + name + "/results.json", text);
+    return dir + "/" + name;
+  };
+  json no_key = *results_;
+  no_key["validation"]["levels"][1].erase("hexes");
+  json wrong_type = *results_;
+  wrong_type["bite_force_N"] = "367.0";
+  const std::string cut = results.substr(0, results.find("\"mesh\""));  // ends inside the object
+  const int cut_line = static_cast<int>(count(cut, "\n")) + 1;
+  write_file(dir + "/a_file", "x");
+  fs::create_directories(dir + "/empty");
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"report", dir + "/no_such", "-o", out}, "'" + dir + "/no_such' does not exist"},
+      {{"report", dir + "/a_file", "-o", out}, "is a file, not a folder"},
+      {{"report", dir + "/empty", "-o", out},
+       "'" + dir + "/empty' holds no results.json, so no finished run: run `hexbite run SCENARIO -o"},
+      {{"report", folder_with("cut", cut), "-o", out, "--no-pictures"},
+       "cut/results.json':" + std::to_string(cut_line) + ":"},
+      {{"report", folder_with("no_key", no_key.dump(1)), "-o", out, "--no-pictures"},
+       "key 'validation.levels[1].hexes' is missing"},
+      {{"report", folder_with("wrong_type", wrong_type.dump(1)), "-o", out, "--no-pictures"},
+       "key 'bite_force_N' is a string, expected a number or null"},
+      {{"report", folder_with("no_vtu", results), "-o", out}, "`outputs: {vtu: false}`"},
+      {{"report", folder_with("no_vtu2", results), "-o", out}, "add --no-pictures"},
+      {{"report", *run_dir_, "-o", dir + "/r.txt"}, "this command writes .html or .htm"},
+      {{"report", *run_dir_, "-o", dir + "/no_such/r.html"}, "folder '" + dir + "/no_such' does not exist"},
+      {{"report", *run_dir_, "-o", dir}, "is a folder"},
+  };
+  for (const Case& c : cases) {
+    const test::CommandResult r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[1] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.fragment << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args[1];
+    EXPECT_FALSE(fs::exists(dir + "/r.txt"));
+  }
+  // The not-JSON case says what is wrong at that line.
+  EXPECT_NE(run_hexbite({"report", dir + "/cut", "-o", out, "--no-pictures"}).err.find("not JSON"),
+            std::string::npos);
+}
+
+// Under mpirun the solution is written in pieces (solution.pvtu): the report draws its pictures from them
+// (before, the renderer read only a single .vtu).
+TEST(ReportMpi, PicturesOfARunUnderMpirunComeFromItsPieces) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/cube.obj", test::cubes_obj(1));
+  std::string text = kCube;
+  text.replace(text.find("validation_levels: 1"), 20, "validation_levels: 0");
+  write_file(dir + "/cube.yaml", text);
+  const test::CommandResult run =
+      run_hexbite({"-q", "run", dir + "/cube.yaml", "-o", dir + "/run"},
+                  {HEXBITE_MPIEXEC, "-np", "2", "--allow-run-as-root", "--oversubscribe"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ASSERT_TRUE(fs::exists(dir + "/run/solution.pvtu"));
+  ASSERT_FALSE(fs::exists(dir + "/run/solution.vtu"));
+  const test::CommandResult c =
+      run_hexbite({"report", dir + "/run", "-o", dir + "/r.html", "--json"}, display_launcher());
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_EQ(json::parse(c.out)["pictures"].size(), 3u) << c.out;
+  const std::string html = read_file(dir + "/r.html");
+  EXPECT_EQ(count(html, "src=\"data:image/png;base64,iVBORw0KGgo"), 3u);  // the PNG signature in base64
+  EXPECT_NE(section(html, "What was run").find("<td>MPI ranks</td><td>2</td>"), std::string::npos);
+  // `hexbite render` reads the pieces too (before: "unknown extension '.pvtu'").
+  const test::CommandResult render =
+      run_hexbite({"-q", "render", dir + "/run/solution.pvtu", "--field", "von_mises", "-o", dir + "/vm.png",
+                   "--width", "320", "--height", "200"},
+                  display_launcher());
+  EXPECT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_EQ(read_file(dir + "/vm.png").substr(1, 3), "PNG");
+}
+
+// Without a display: the hint of `hexbite render` (exit 1, nothing written), unless --no-pictures.
+TEST_F(Report, WithoutDisplayNeedsXvfbOrNoPictures) {
+  const std::string dir = temp_dir();
+  const test::CommandResult r =
+      run_hexbite({"report", *run_dir_, "-o", dir + "/r.html"}, {"env", "-u", "DISPLAY"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("no X display"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("xvfb-run -a"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--no-pictures"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/r.html"));
+  EXPECT_EQ(run_hexbite({"-q", "report", *run_dir_, "-o", dir + "/r.html", "--no-pictures"},
+                        {"env", "-u", "DISPLAY"})
+                .exit_code,
+            0);
+  EXPECT_TRUE(fs::exists(dir + "/r.html"));
+}
+
+}  // namespace
+}  // namespace hexbite
