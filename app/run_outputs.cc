@@ -310,6 +310,7 @@ json results_json(const RunResult& r, double seconds_output) {
   j.erase("dofs");
   j["scenario"] = s.name;
   j["scenario_file"] = s.path;
+  j["hexbite_version"] = HEXBITE_VERSION;
   j["mesh_method"] = s.mesh.method == MeshMethod::kSheets ? "sheets" : "grid";
   j["mesh"] = {{"hexes", coarse.mesh.hexes.size()},
                {"nodes", coarse.mesh.vertices.size()},
@@ -318,19 +319,47 @@ json results_json(const RunResult& r, double seconds_output) {
                {"quality", quality_to_json(coarse.quality)},
                {"fidelity", fidelity_to_json(r.fidelity)}};
   if (!r.mesh_core.empty()) j["mesh"]["core"] = r.mesh_core;
+  // The model as solved, so that a report (hexbite report) can say what was simulated without the scenario.
+  json regions = json::array();
+  for (std::size_t i = 0; i < s.materials.regions.size(); ++i) {
+    const MaterialRegion& m = s.materials.regions[i];
+    regions.push_back({{"name", m.name},
+                       {"E_MPa", m.material.E_MPa},
+                       {"poisson", m.material.poisson},
+                       {"hexes", coarse.region_hexes[i]}});
+  }
+  j["materials"] = {
+      {"default",
+       {{"E_MPa", s.materials.default_material.E_MPa}, {"poisson", s.materials.default_material.poisson}}},
+      {"regions", regions}};
   json muscles = json::array();
-  for (std::size_t i = 0; i < coarse.muscle_patches.size(); ++i)
-    muscles.push_back({{"name", coarse.muscle_patches[i].name},
-                       {"force_N", vec(coarse.muscle_forces[i])},
-                       {"magnitude_N", norm(coarse.muscle_forces[i])},
-                       {"patch_area_mm2", coarse.muscle_patches[i].area_mm2},
-                       {"facets", coarse.muscle_patches[i].faces.size()}});
+  std::size_t active = 0;
+  for (const Muscle& m : s.muscles) {
+    if (m.activation <= 0) continue;  // the patches and forces of the active muscles, in scenario order
+    muscles.push_back({{"name", coarse.muscle_patches[active].name},
+                       {"activation", m.activation},
+                       {"force_N", vec(coarse.muscle_forces[active])},
+                       {"magnitude_N", norm(coarse.muscle_forces[active])},
+                       {"patch_area_mm2", coarse.muscle_patches[active].area_mm2},
+                       {"facets", coarse.muscle_patches[active].faces.size()}});
+    ++active;
+  }
   j["muscles"] = muscles;
   json supports = json::array();
-  for (std::size_t i = 0; i < s.supports.size(); ++i)
-    supports.push_back({{"name", s.supports[i].name},
+  for (std::size_t i = 0; i < s.supports.size(); ++i) {
+    const Support& sup = s.supports[i];
+    json fixed = json::array();
+    for (int k = 0; k < 3 && !sup.spring_N_per_mm3; ++k)
+      if (sup.fixed[static_cast<std::size_t>(k)]) fixed.push_back(std::string(1, "xyz"[k]));
+    supports.push_back({{"name", sup.name},
+                        {"center_mm", vec(sup.at.xyz)},
+                        {"radius_mm", sup.radius_mm},
+                        {"fixed", fixed},
+                        {"spring_N_per_mm3", sup.spring_N_per_mm3 ? json(*sup.spring_N_per_mm3) : json()},
+                        {"bite", sup.bite},
                         {"patch_area_mm2", coarse.support_patches[i].area_mm2},
                         {"facets", coarse.support_patches[i].faces.size()}});
+  }
   j["supports"] = supports;
   json hold = json::array();
   for (const RigidMode& m : r.support_hold) {

@@ -359,6 +359,7 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
     for (std::size_t i = 0; i < regions && level == 0; ++i)
       nearest_centre[i] = std::min(nearest_centre[i], distance_outside(s.materials.regions[i], centre));
   }
+  r.region_hexes = hexes_of_region;
   for (std::size_t i = 0; i < regions && level == 0; ++i) {
     if (hexes_of_region[i] > 0) continue;
     const MaterialRegion& region = s.materials.regions[i];

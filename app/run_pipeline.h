@@ -40,6 +40,7 @@ struct LevelResult {
   std::vector<Vec3> muscle_forces;         // N, total force of each of those muscles
   std::vector<MeshPatch> support_patches;  // every support, in scenario order
   std::vector<Material> hex_material;      // one per hex
+  std::vector<int> region_hexes;  // per material region (scenario order): the hexes it gives its material
   ElasticitySolution solution;
   double seconds_mesh = 0.0;   // meshing (level 0) or refinement (levels > 0)
   double seconds_solve = 0.0;  // the solver call

@@ -84,8 +84,11 @@ void what_was_run(std::ostringstream& out, const RunFigures& r, const ReportOpti
   out << "<h2>What was run</h2>\n";
   Table t(out);
   t.row({text("scenario"), text(html_escape(r.scenario) + " (file " + html_escape(r.scenario_file) + ")")});
-  t.row({text("hexbite"), text("report written by hexbite " + html_escape(o.hexbite_version) +
-                               "; results.json does not record the version that ran")});
+  t.row({text("hexbite"), text(r.hexbite_version.empty()
+                                   ? "report written by hexbite " + html_escape(o.hexbite_version) +
+                                         "; this results.json does not record the version that ran"
+                                   : "run with hexbite " + html_escape(r.hexbite_version) +
+                                         ", report written by hexbite " + html_escape(o.hexbite_version))});
   t.row({text("mesh"), text("method " + html_escape(r.mesh_method) +
                             (r.mesh_core.empty() ? "" : ", core " + html_escape(r.mesh_core)) + "; " +
                             format_count(l.hexes) + " hexes, " + format_count(l.nodes) + " nodes")});
@@ -105,6 +108,64 @@ void warnings_section(std::ostringstream& out, const std::vector<std::string>& w
   out << "<h2>Warnings</h2>\n<div class=\"warnings\"><ul>\n";
   for (const std::string& w : warnings) out << "<li>" << html_escape(w) << "</li>\n";
   out << "</ul></div>\n";
+}
+
+// What was simulated: the materials, the muscle loads and the supports, as results.json records them.
+void model_section(std::ostringstream& out, const RunFigures& r) {
+  out << "<h2>Model</h2>\n";
+  if (r.default_material) {
+    long in_regions = 0;
+    for (const MaterialFigures& m : r.material_regions) in_regions += m.hexes.value_or(0);
+    Table t(out);
+    t.header({text("material"), num("E (MPa)"), num("Poisson&rsquo;s ratio"), num("hexes")});
+    const auto row = [&](const std::string& name, const MaterialFigures& m, long hexes) {
+      char e[32], nu[32];
+      std::snprintf(e, sizeof e, "%g", m.E_MPa);
+      std::snprintf(nu, sizeof nu, "%g", m.poisson);
+      t.row({text(name), num(e), num(nu), num(format_count(hexes))});
+    };
+    row("bone (default)", *r.default_material, r.coarse.hexes - in_regions);
+    for (const MaterialFigures& m : r.material_regions)
+      row("region " + html_escape(m.name), m, m.hexes.value_or(0));
+  } else {
+    out << "<p>This results.json records no materials (it was written by an older hexbite): see the "
+           "scenario file.</p>\n";
+  }
+  if (!r.muscles.empty()) {
+    out << "<p>Muscle loads: uniform tractions over each insertion patch, along the line of action.</p>\n";
+    Table t(out);
+    t.header({text("muscle"), num("activation"), num("force (N)"), text("direction"),
+              num("patch (mm<sup>2</sup>)")});
+    for (const MuscleFigures& m : r.muscles) {
+      char activation[32];
+      std::snprintf(activation, sizeof activation, "%.2f", m.activation.value_or(0));
+      const Vec3 unit = m.magnitude > 0 ? vec3::scale(m.force, 1.0 / m.magnitude) : m.force;
+      t.row({text(html_escape(m.name)), num(m.activation ? activation : "n/a"),
+             num(format_newtons(m.magnitude)), text(format_point(unit, 2)),
+             num(format_count(std::lround(m.patch_area_mm2)))});
+    }
+  }
+  if (r.supports.empty()) return;
+  out << "<p>Supports: patches of the bone surface around a centre.</p>\n";
+  Table t(out);
+  t.header({text("support"), text("condition"), text("centre (mm)"), num("radius (mm)"),
+            num("patch (mm<sup>2</sup>)")});
+  for (const SupportFigures& s : r.supports) {
+    std::string condition = "n/a";
+    if (s.spring_N_per_mm3) {
+      char k[64];
+      std::snprintf(k, sizeof k, "spring, %g N/mm<sup>3</sup>", *s.spring_N_per_mm3);
+      condition = k;
+    } else if (s.fixed) {
+      condition = "fixed";
+      for (std::size_t i = 0; i < s.fixed->size(); ++i)
+        condition += (i == 0 ? " " : ", ") + html_escape((*s.fixed)[i]);
+    }
+    char radius[32];
+    std::snprintf(radius, sizeof radius, "%g", s.radius_mm.value_or(0));
+    t.row({text(html_escape(s.name)), text(condition), text(s.center ? format_point(*s.center) : "n/a"),
+           num(s.radius_mm ? radius : "n/a"), num(format_count(std::lround(s.patch_area_mm2)))});
+  }
 }
 
 void results_section(std::ostringstream& out, const RunFigures& r) {
@@ -317,6 +378,7 @@ std::string report_html(const RunFigures& r, const std::vector<std::string>& war
       << "</h1>\n<p class=\"subtitle\">Bite-force validation report of a <code>hexbite run</code></p>\n";
   what_was_run(out, r, o);
   warnings_section(out, warnings);
+  model_section(out, r);
   results_section(out, r);
   validation_section(out, r);
   quality_section(out, r);

@@ -1,9 +1,9 @@
 // The validation report of a finished run (hexbite report): one self-contained HTML file, inline CSS and
 // pictures embedded as PNG data URIs, no scripts or external resources, laid out for A4. Contents in
-// order: title, what was run, warnings (when there are any), results of the coarse level, the convergence
-// table of the validation levels, mesh quality (the seed paper's Table 1 layout) and geometric fidelity,
-// probes, solver, pictures. Every string from results.json is HTML-escaped. Deterministic: the same figures
-// and pictures give the same bytes.
+// order: title, what was run, warnings (when there are any), the model (materials, muscle loads, supports),
+// results of the coarse level, the convergence table of the validation levels, mesh quality (the seed
+// paper's Table 1 layout) and geometric fidelity, probes, solver, pictures. Every string from results.json
+// is HTML-escaped. Deterministic: the same figures and pictures give the same bytes.
 #pragma once
 
 #include <string>

@@ -136,6 +136,51 @@ LevelFigures level_figures(const Checked& c, const Key& l, const std::vector<std
   return f;
 }
 
+// The model as solved: materials, muscles and supports. A results.json written before the report existed
+// lacks the materials and the supports' centres, radii and conditions, so those are optional.
+void read_model(const Checked& c, const Key& top, RunFigures& r) {
+  const auto optional_number = [&](const Key& k, const char* name) {
+    return c.has(k, name) ? c.number_or_null(c.child(k, name)) : std::nullopt;
+  };
+  if (c.has(top, "materials")) {
+    const Key materials = c.child(top, "materials");
+    const Key d = c.child(materials, "default");
+    r.default_material = MaterialFigures{"", c.number(d, "E_MPa"), c.number(d, "poisson"), std::nullopt};
+    const Key regions = c.child(materials, "regions");
+    for (std::size_t i = 0; i < c.array(regions).size(); ++i) {
+      const Key m = c.item(regions, i);
+      r.material_regions.push_back(
+          {c.text(c.child(m, "name")), c.number(m, "E_MPa"), c.number(m, "poisson"), c.whole(m, "hexes")});
+    }
+  }
+  if (c.has(top, "muscles")) {
+    const Key muscles = c.child(top, "muscles");
+    for (std::size_t i = 0; i < c.array(muscles).size(); ++i) {
+      const Key m = c.item(muscles, i);
+      r.muscles.push_back({c.text(c.child(m, "name")), optional_number(m, "activation"), c.vec(m, "force_N"),
+                           c.number(m, "magnitude_N"), c.number(m, "patch_area_mm2")});
+    }
+  }
+  if (c.has(top, "supports")) {
+    const Key supports = c.child(top, "supports");
+    for (std::size_t i = 0; i < c.array(supports).size(); ++i) {
+      const Key k = c.item(supports, i);
+      SupportFigures s;
+      s.name = c.text(c.child(k, "name"));
+      if (c.has(k, "center_mm")) s.center = c.vec(k, "center_mm");
+      s.radius_mm = optional_number(k, "radius_mm");
+      s.spring_N_per_mm3 = optional_number(k, "spring_N_per_mm3");
+      if (c.has(k, "fixed")) {
+        const Key fixed = c.child(k, "fixed");
+        s.fixed.emplace();
+        for (std::size_t j = 0; j < c.array(fixed).size(); ++j) s.fixed->push_back(c.text(c.item(fixed, j)));
+      }
+      s.patch_area_mm2 = c.number(k, "patch_area_mm2");
+      r.supports.push_back(s);
+    }
+  }
+}
+
 // Line and column (1-based) of byte `byte` (1-based, as nlohmann's parse_error counts) of `text`.
 std::pair<int, int> line_and_column(const std::string& text, std::size_t byte) {
   int line = 1, column = 1;
@@ -219,12 +264,10 @@ RunFigures read_run_figures(const std::string& path) {
       r.support_hold.push_back(s);
     }
   }
+  if (c.has(top, "hexbite_version")) r.hexbite_version = c.text(c.child(top, "hexbite_version"));
+  read_model(c, top, r);
   std::vector<std::string> support_order;
-  if (c.has(top, "supports")) {
-    const Key supports = c.child(top, "supports");
-    for (std::size_t i = 0; i < c.array(supports).size(); ++i)
-      support_order.push_back(c.text(c.child(c.item(supports, i), "name")));
-  }
+  for (const SupportFigures& s : r.supports) support_order.push_back(s.name);
   r.coarse = level_figures(c, top, support_order);
   r.coarse.hexes = c.whole(mesh, "hexes");
   r.coarse.nodes = c.whole(mesh, "nodes");

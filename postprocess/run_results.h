@@ -71,8 +71,36 @@ struct SupportHoldFigures {
   std::optional<Vec3> axis_point;  // rotations
 };
 
+// The model as solved (results.json materials, muscles, supports). Keys that a results.json of an older
+// hexbite lacks are none.
+struct MaterialFigures {
+  std::string name;  // of a region; empty for the default
+  double E_MPa = 0, poisson = 0;
+  std::optional<long> hexes;  // regions: the coarse mesh's hexes that take this material
+};
+
+struct MuscleFigures {
+  std::string name;
+  std::optional<double> activation;
+  Vec3 force{0, 0, 0};  // N
+  double magnitude = 0, patch_area_mm2 = 0;
+};
+
+struct SupportFigures {
+  std::string name;
+  std::optional<Vec3> center;  // mm
+  std::optional<double> radius_mm, spring_N_per_mm3;
+  std::optional<std::vector<std::string>> fixed;  // the fixed components, "x" "y" "z"
+  double patch_area_mm2 = 0;
+};
+
 struct RunFigures {
   std::string scenario, scenario_file, mesh_method, mesh_core;  // mesh_core empty for method sheets
+  std::string hexbite_version;                                  // of the run; empty in older files
+  std::optional<MaterialFigures> default_material;              // none in older files
+  std::vector<MaterialFigures> material_regions;
+  std::vector<MuscleFigures> muscles;    // the active ones
+  std::vector<SupportFigures> supports;  // in the scenario's order
   int degree = 1;
   QualityFigures scaled_jacobian, condition, condition_verdict, oddy;
   long inverted = 0;

@@ -233,6 +233,63 @@ TEST(ReportWarnings, WeakSupportsAreWarnedAboutFirst) {
   EXPECT_NE(c.err.find("hexbite: warning: Weak supports"), std::string::npos) << c.err;
 }
 
+// What was simulated is in the report, from results.json alone: the materials with the hexes each takes, the
+// muscle loads, and each support's condition (fixed components or a spring), centre and radius.
+TEST(ReportModel, StatesTheMaterialsTheLoadsAndTheSupports) {
+  std::string text = kCube;
+  text.replace(text.find("validation_levels: 1"), 20, "validation_levels: 0");
+  text.replace(text.find("supports:"), std::string::npos,
+               "materials:\n"
+               "  default: {E_MPa: 11000, poisson: 0.3}\n"
+               "  regions:\n"
+               "    - {name: graft<1>, box: {min: [10, -1, -1], max: [21, 21, 21]}, E_MPa: 2200}\n"
+               "supports:\n"
+               "  - {name: nut, at: [0, 10, 10], radius_mm: 5, bite: true}\n"
+               "  - {name: floor_rest, at: [10, 10, 0], radius_mm: 4, fixed: [y, z]}\n"
+               "  - {name: pad, at: [10, 20, 10], radius_mm: 4.5, spring_N_per_mm3: 25}\n");
+  const std::string run = run_cube(text);
+  const json r = json::parse(read_file(run + "/results.json"));
+  const long graft = r["materials"]["regions"][0]["hexes"].get<long>();
+  const long hexes = r["mesh"]["hexes"].get<long>();
+  ASSERT_GT(graft, 0);
+  ASSERT_LT(graft, hexes);
+  EXPECT_EQ(r["supports"][1]["fixed"], json::parse(R"(["y", "z"])"));
+  EXPECT_TRUE(r["supports"][2]["fixed"].empty());
+  EXPECT_EQ(r["supports"][2]["spring_N_per_mm3"].get<double>(), 25.0);
+  EXPECT_EQ(r["muscles"][0]["activation"].get<double>(), 1.0);
+
+  const std::string out = temp_dir() + "/model.html";
+  const test::CommandResult c = run_hexbite({"-q", "report", run, "-o", out, "--no-pictures"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const std::string html = read_file(out);
+  const std::string model = section(html, "Model");
+  ASSERT_FALSE(model.empty()) << html;
+  EXPECT_LT(html.find("<h2>Model"), html.find("<h2>Results"));
+  EXPECT_NE(model.find("<td>bone (default)</td><td class=\"n\">11000</td><td class=\"n\">0.3</td><td "
+                       "class=\"n\">" +
+                       std::to_string(hexes - graft) + "</td>"),
+            std::string::npos)
+      << model;
+  EXPECT_NE(model.find("<td>region graft&lt;1&gt;</td><td class=\"n\">2200</td><td class=\"n\">0.3</td><td "
+                       "class=\"n\">" +
+                       std::to_string(graft) + "</td>"),
+            std::string::npos)
+      << model;
+  EXPECT_NE(model.find("<td>pull</td><td class=\"n\">1.00</td><td class=\"n\">100.0</td><td>(1.00, 0.00, "
+                       "0.00)</td>"),
+            std::string::npos)
+      << model;
+  EXPECT_NE(model.find("<td>nut</td><td>fixed x, y, z</td><td>(0.0, 10.0, 10.0)</td><td class=\"n\">5</td>"),
+            std::string::npos)
+      << model;
+  EXPECT_NE(model.find("<td>floor_rest</td><td>fixed y, z</td>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td>pad</td><td>spring, 25 N/mm<sup>3</sup></td><td>(10.0, 20.0, 10.0)</td><td "
+                       "class=\"n\">4.5</td>"),
+            std::string::npos)
+      << model;
+  EXPECT_NE(section(html, "What was run").find("run with hexbite "), std::string::npos);
+}
+
 TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   const std::string dir = temp_dir(), out = dir + "/r.html";
   const std::string results = read_file(*run_dir_ + "/results.json");
