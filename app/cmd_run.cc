@@ -4,9 +4,10 @@
 // DIR/results.json, DIR/mesh.vtu, DIR/solution*.vtu (or .pvtu under mpirun) and, with --export inp,
 // DIR/model.inp for CalculiX. A scenario error (exit 2) is found before anything is solved or written; a
 // failure while writing (exit 1) leaves DIR as it was, the set is moved in only when complete. The
-// equilibrium residual of every level is checked after the results are written: above
-// kEquilibriumTolerance the run fails (exit 1), so a wrong answer never passes silently but stays
-// inspectable. Under mpirun every rank runs this command; rank 0 prints and writes (docs/running.md).
+// equilibrium residual and the largest displacement of every level are checked after the results are
+// written (require_trustworthy): a failed check fails the run (exit 1), so a wrong answer never passes
+// silently but stays inspectable. Under mpirun every rank runs this command; rank 0 prints and writes
+// (docs/running.md).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -23,22 +24,11 @@
 #include "app/run_pipeline.h"
 #include "common/error.h"
 #include "common/progress.h"
-#include "mesher/tri_surface.h"
 #include "solver/mpi_session.h"
 
 namespace hexbite {
 
 namespace {
-
-// Applied forces plus reactions must vanish; the solver's tolerance (1e-10 by default) leaves residuals
-// of order 1e-11, so 1e-8 separates a converged solve from wrong bookkeeping with a wide margin.
-constexpr double kEquilibriumTolerance = 1e-8;
-
-// Linear elasticity assumes displacements small against the body: a largest displacement beyond this
-// fraction of the bone's size (about 10 mm on a mandible, whose bite moves it by about 0.1 mm) comes from
-// a Young's modulus or a force in the wrong unit, or from supports that barely hold the bone, and the
-// figures mean nothing.
-constexpr double kMaxDisplacementFraction = 0.1;
 
 struct RunCliOptions {
   std::string scenario;
@@ -81,31 +71,7 @@ void run_run(const RunCliOptions& o) {
     std::cout << " (" << total << " s in all)\n";
   }
 
-  const double size = largest_extent(result.levels.front().mesh.vertices);
-  for (const LevelResult& l : result.levels) {
-    if (!(l.solution.equilibrium_residual <= kEquilibriumTolerance)) {
-      // %.3g: std::to_string printed a residual of 3e-8 as "0.000000 > 1e-8".
-      const SolverSpec& solver = result.scenario.solver;
-      char text[160];
-      std::snprintf(text, sizeof text, "relative residual %.3g > 1e-8", l.solution.equilibrium_residual);
-      char tolerance[32];
-      std::snprintf(tolerance, sizeof tolerance, "%g", solver.tolerance);
-      throw RunError(
-          "level " + std::to_string(l.level) + ": applied forces and reactions do not balance (" + text +
-          "); the results in " + o.output + " are not trustworthy: tighten solver.tolerance (" + tolerance +
-          (solver.where.line ? ", solver at " + solver.where.str() : std::string(", the default")) + ")");
-    }
-    if (l.solution.max_displacement > kMaxDisplacementFraction * size) {
-      char text[400];
-      std::snprintf(text, sizeof text,
-                    "level %d: the largest displacement, %.3g mm, is more than %.0f %% of the bone's size "
-                    "(%.1f mm), but linear elasticity holds only for small displacements",
-                    l.level, l.solution.max_displacement, 100 * kMaxDisplacementFraction, size);
-      throw RunError(std::string(text) + "; the results in " + o.output +
-                     " are meaningless: check materials E_MPa (in MPa, cortical bone about 11000), the "
-                     "muscles' max_force_N (in N) and that the supports hold the bone");
-    }
-  }
+  require_trustworthy(result, "the results in " + o.output);
 }
 
 }  // namespace

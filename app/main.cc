@@ -24,12 +24,12 @@
 namespace {
 
 // Starting MPI (and with it PETSc, p4est and Trilinos) costs about half a second, which every quick command
-// would pay for nothing: only `run` calls the solver. The main program's own options are all flags, so the
-// first argument that is not an option names the subcommand.
+// would pay for nothing: only `run` and `study` call the solver. The main program's own options are all
+// flags, so the first argument that is not an option names the subcommand.
 bool command_uses_solver(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (!arg.empty() && arg[0] != '-') return arg == "run";
+    if (!arg.empty() && arg[0] != '-') return arg == "run" || arg == "study";
   }
   return false;
 }
@@ -150,6 +150,7 @@ int main(int argc, char** argv) {
   hexbite::add_refine_command(app);
   hexbite::add_reorder_command(app);
   hexbite::add_run_command(app);
+  hexbite::add_study_command(app);
   hexbite::add_quad_commands(app);
   hexbite::add_report_command(app);
 

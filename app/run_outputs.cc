@@ -392,14 +392,6 @@ json results_json(const RunResult& r, double seconds_output) {
 
 namespace {
 
-// The names of the files a run may write but results.json (which every run writes): those of an earlier run
-// into the same folder that this run does not rewrite are removed when this run's set is moved in.
-bool is_output_name(const std::string& name) {
-  static const std::regex kOutputName(
-      R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
-  return std::regex_match(name, kOutputName);
-}
-
 void broadcast(std::string* text, int root) {
   unsigned long size = text->size();
   MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG, root, MPI_COMM_WORLD);
@@ -408,6 +400,12 @@ void broadcast(std::string* text, int root) {
 }
 
 }  // namespace
+
+bool is_run_output_name(const std::string& name) {
+  static const std::regex kOutputName(
+      R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
+  return std::regex_match(name, kOutputName);
+}
 
 RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
   while (dir_.size() > 1 && dir_.back() == '/') dir_.pop_back();  // as OutputStage names it
@@ -508,7 +506,7 @@ void RunOutputs::commit(const std::string& results_text) {
         if (!root) return;
         std::vector<std::string> files = files_;
         files.push_back("results.json");  // last: a script that waits for it finds the whole set
-        stage_->commit(files, is_output_name);
+        stage_->commit(files, is_run_output_name);
       },
       kCommitNote);
 }

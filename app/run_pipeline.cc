@@ -28,6 +28,7 @@
 #include "mesher/mandible_sheet_mesher.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_projector.h"
+#include "mesher/tri_surface.h"
 #include "mesher/union_find.h"
 #include "mesher/units.h"
 #include "mesher/vec3.h"
@@ -36,6 +37,16 @@
 namespace hexbite {
 
 namespace {
+
+// Applied forces plus reactions must vanish; the solver's tolerance (1e-10 by default) leaves residuals
+// of order 1e-11, so 1e-8 separates a converged solve from wrong bookkeeping with a wide margin.
+constexpr double kEquilibriumTolerance = 1e-8;
+
+// Linear elasticity assumes displacements small against the body: a largest displacement beyond this
+// fraction of the bone's size (about 10 mm on a mandible, whose bite moves it by about 0.1 mm) comes from
+// a Young's modulus or a force in the wrong unit, or from supports that barely hold the bone, and the
+// figures mean nothing.
+constexpr double kMaxDisplacementFraction = 0.1;
 
 // Below this many degrees of freedom `linear_solver: auto` factorizes (MUMPS): on this machine that is
 // faster than setting up the AMG hierarchy, and above it the factorization's fill-in makes CG + AMG win.
@@ -682,7 +693,7 @@ std::vector<std::pair<int, Vec3>> consistent_nodal_forces(const HexMesh& mesh,
   return {forces.begin(), forces.end()};
 }
 
-RunResult run_pipeline(Scenario scenario, int levels) {
+RunResult prepare_run(Scenario scenario, int levels) {
   const auto start = std::chrono::steady_clock::now();
   RunResult result;
   Geometry geometry;
@@ -738,9 +749,48 @@ RunResult run_pipeline(Scenario scenario, int levels) {
     progress.finish(std::to_string(result.levels.back().mesh.hexes.size()) + " hexes");
   }
 
-  for (LevelResult& level : result.levels) solve_level(scenario, level);
   result.scenario = std::move(scenario);
   result.seconds_total = seconds_since(start);
+  return result;
+}
+
+void solve_run(RunResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  for (LevelResult& level : result.levels) solve_level(result.scenario, level);
+  result.seconds_total += seconds_since(start);
+}
+
+void require_trustworthy(const RunResult& result, const std::string& results) {
+  const double size = largest_extent(result.levels.front().mesh.vertices);
+  for (const LevelResult& l : result.levels) {
+    if (!(l.solution.equilibrium_residual <= kEquilibriumTolerance)) {
+      // %.3g: std::to_string printed a residual of 3e-8 as "0.000000 > 1e-8".
+      const SolverSpec& solver = result.scenario.solver;
+      char text[160];
+      std::snprintf(text, sizeof text, "relative residual %.3g > 1e-8", l.solution.equilibrium_residual);
+      char tolerance[32];
+      std::snprintf(tolerance, sizeof tolerance, "%g", solver.tolerance);
+      throw RunError(
+          "level " + std::to_string(l.level) + ": applied forces and reactions do not balance (" + text +
+          "); " + results + " are not trustworthy: tighten solver.tolerance (" + tolerance +
+          (solver.where.line ? ", solver at " + solver.where.str() : std::string(", the default")) + ")");
+    }
+    if (l.solution.max_displacement > kMaxDisplacementFraction * size) {
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    "level %d: the largest displacement, %.3g mm, is more than %.0f %% of the bone's size "
+                    "(%.1f mm), but linear elasticity holds only for small displacements",
+                    l.level, l.solution.max_displacement, 100 * kMaxDisplacementFraction, size);
+      throw RunError(std::string(text) + "; " + results +
+                     " are meaningless: check materials E_MPa (in MPa, cortical bone about 11000), the "
+                     "muscles' max_force_N (in N) and that the supports hold the bone");
+    }
+  }
+}
+
+RunResult run_pipeline(Scenario scenario, int levels) {
+  RunResult result = prepare_run(std::move(scenario), levels);
+  solve_run(result);
   return result;
 }
 

@@ -71,4 +71,17 @@ double patch_area(const HexMesh& mesh, const std::vector<BoundaryQuad>& faces);
 // Runs the pipeline. `levels` validation levels follow the coarse solve. Throws as described above.
 RunResult run_pipeline(Scenario scenario, int levels);
 
+// run_pipeline() in two halves, for a caller that checks several scenarios before it solves any (a study,
+// app/cmd_study.cc): prepare_run() does everything but the solves (geometry, points, meshes and patches of
+// every level, and every check that needs them), so its InputErrors come before any solve; its result has
+// no solutions yet. solve_run() then solves every level. seconds_total adds up the time of both.
+RunResult prepare_run(Scenario scenario, int levels);
+void solve_run(RunResult& result);
+
+// The checks of a solved run that no scenario check can make in advance: applied forces and reactions
+// balance at every level (relative residual at most 1e-8), and the largest displacement stays below 10 % of
+// the bone's size (linear elasticity). Throws RunError naming the level, the figure and what to check;
+// `results` names the results in question for the message ("the results in out").
+void require_trustworthy(const RunResult& result, const std::string& results);
+
 }  // namespace hexbite

@@ -60,17 +60,24 @@ void OutputStage::discard() noexcept {
 void OutputStage::commit(const std::vector<std::string>& files,
                          const std::function<bool(const std::string&)>& retire) {
   const fs::path dir(dir_), stage(stage_), previous = fs::path(stage_) / ".previous";
-  // Every move done so far, to be undone (last first) when a later one fails.
+  // Every move done so far, to be undone (last first) when a later one fails; a move without `from` is a
+  // folder made in the output folder, removed again.
   struct Move {
     fs::path from, to;
   };
   std::vector<Move> done;
   const auto move = [&](const fs::path& from, const fs::path& to, const fs::path& named) {
     std::error_code ec;
+    fs::create_directories(to.parent_path(), ec);  // inside the stage's .previous: removed with the stage
     fs::rename(from, to, ec);
     if (ec) throw RunError("cannot write '" + named.string() + "': " + ec.message());
     done.push_back({from, to});
   };
+  // The folders of the output folder that the files go into ("" for the output folder itself).
+  std::set<std::string> folders = {""};
+  for (const std::string& name : files)
+    for (fs::path p = fs::path(name).parent_path(); !p.empty(); p = p.parent_path())
+      folders.insert(p.string());
   try {
     std::error_code ec;
     fs::create_directory(previous, ec);
@@ -80,12 +87,17 @@ void OutputStage::commit(const std::vector<std::string>& files,
     const std::set<std::string> writing(files.begin(), files.end());
     if (retire) {
       std::vector<std::string> stale;
-      for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
-        const std::string name = entry.path().filename().string();
-        std::error_code kind;
-        if (retire(name) && writing.count(name) == 0 && !entry.is_directory(kind)) stale.push_back(name);
+      for (const std::string& folder : folders) {
+        if (!fs::is_directory(dir / folder, ec)) continue;
+        const std::string prefix = folder.empty() ? "" : folder + "/";
+        for (const fs::directory_entry& entry : fs::directory_iterator(dir / folder, ec)) {
+          const std::string name = prefix + entry.path().filename().string();
+          std::error_code kind;
+          if (retire(name) && writing.count(name) == 0 && !entry.is_directory(kind)) stale.push_back(name);
+        }
+        if (ec)
+          throw RunError("cannot list the output folder '" + (dir / folder).string() + "': " + ec.message());
       }
-      if (ec) throw RunError("cannot list the output folder '" + dir_ + "': " + ec.message());
       std::sort(stale.begin(), stale.end());
       for (const std::string& name : stale) move(dir / name, previous / name, dir / name);
     }
@@ -94,6 +106,19 @@ void OutputStage::commit(const std::vector<std::string>& files,
       if (!fs::is_regular_file(staged, ec))
         throw RunError("cannot write '" + target.string() + "': it was not written to " + stage_ +
                        " (under mpirun the output folder must be on a file system that every rank sees)");
+      // The folders above the file inside the output folder, outermost first.
+      std::vector<fs::path> above;
+      for (fs::path p = fs::path(name).parent_path(); !p.empty(); p = p.parent_path()) above.push_back(p);
+      for (auto p = above.rbegin(); p != above.rend(); ++p) {
+        const fs::file_status status = fs::symlink_status(dir / *p, ec);
+        if (fs::is_directory(status)) continue;
+        if (fs::exists(status))
+          throw RunError("cannot write '" + target.string() + "': '" + (dir / *p).string() +
+                         "' is a file, not a folder; remove or rename it, or choose another output folder");
+        fs::create_directory(dir / *p, ec);
+        if (ec) throw RunError("cannot write '" + target.string() + "': " + ec.message());
+        done.push_back({fs::path(), dir / *p});
+      }
       const fs::file_status old = fs::symlink_status(target, ec);
       if (fs::is_directory(old))
         throw RunError("cannot write '" + target.string() +
@@ -108,6 +133,10 @@ void OutputStage::commit(const std::vector<std::string>& files,
     std::string stuck;
     for (auto it = done.rbegin(); it != done.rend(); ++it) {
       std::error_code ec;
+      if (it->from.empty()) {
+        fs::remove(it->to, ec);  // a folder this commit made, empty again by now
+        continue;
+      }
       fs::rename(it->to, it->from, ec);
       if (ec) stuck += (stuck.empty() ? "" : ", ") + it->to.string();
     }

@@ -39,9 +39,11 @@ class OutputStage {
 
   // Moves the staged `files` (names relative to the folders, in this order) into the output folder,
   // replacing files of those names, and removes the other files of the output folder for which
-  // `retire(name)` is true (files of an earlier run that this one does not rewrite). All or nothing: when
-  // a move fails (a folder in the way of a name, a file missing from the stage), everything done is undone
-  // and RunError names the file and what to do. Then removes the stage.
+  // `retire(name)` is true (files of an earlier run that this one does not rewrite). A name may lie in a
+  // folder ("soft_bone/results.json": a study's variant): the folder is made in the output folder when it is
+  // missing, and `retire` is asked about the files of that folder too, by the same relative names. All or
+  // nothing: when a move fails (a folder in the way of a name, a file missing from the stage), everything
+  // done is undone and RunError names the file and what to do. Then removes the stage.
   void commit(const std::vector<std::string>& files,
               const std::function<bool(const std::string&)>& retire = nullptr);
 

@@ -7,10 +7,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <tuple>
 #include <utility>
 
@@ -19,30 +17,20 @@
 #include "mesher/grid_mesher.h"
 #include "mesher/quad_local_refinement.h"
 #include "mesher/units.h"
+#include "scenarios/scenario_tree.h"
+#include "scenarios/yaml_input.h"
 
 namespace hexbite {
 
 std::string SourceLocation::str() const {
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + (note.empty() ? "" : ": " + note);
 }
 
 namespace {
 
 namespace fs = std::filesystem;
 
-// What every parsing function needs to know about the file it reads.
-struct Ctx {
-  std::string file;  // as given, for messages
-  fs::path folder;   // relative paths inside the scenario are resolved against it
-};
-
-[[noreturn]] void fail(const SourceLocation& where, const std::string& message) {
-  throw InputError(where.str() + ": " + message);
-}
-
-std::string quote(const std::string& s) {
-  return "'" + s + "'";
-}
+using namespace yaml_input;
 
 std::string fmt(double x) {
   return format_significant(x);
@@ -50,43 +38,6 @@ std::string fmt(double x) {
 
 std::string fmt(const Vec3& p) {
   return "[" + fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + "]";
-}
-
-std::string join_quoted(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& item : items) out += (out.empty() ? "" : ", ") + quote(item);
-  return out;
-}
-
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-// "did you mean 'x'?" when a valid choice is within a few edits (typos), else the whole list, so that
-// the message always says what to write instead.
-std::string suggestion(const std::string& given, const std::vector<std::string>& valid,
-                       const std::string& noun = "choices") {
-  const std::string* best = nullptr;
-  size_t best_distance = std::numeric_limits<size_t>::max();
-  for (const auto& v : valid) {
-    const size_t d = edit_distance(given, v);
-    if (d < best_distance) best_distance = d, best = &v;
-  }
-  // A one-letter slip in a one-letter word is no evidence of a typo, hence the second condition.
-  if (best && best_distance <= std::max<size_t>(2, given.size() / 3) && best_distance < given.size())
-    return "did you mean " + quote(*best) + "?";
-  return "valid " + noun + " are " + join_quoted(valid);
 }
 
 std::vector<std::string> split_tokens(const std::string& name) {
@@ -122,26 +73,6 @@ std::vector<std::string> closest_names(const std::string& given, const std::vect
   return out;
 }
 
-// A YAML node with where it was written and its path in the document ("muscles[2].activation").
-struct Value {
-  YAML::Node node;
-  SourceLocation at;
-  std::string path;
-};
-
-// Text by the file's word: quoted ("0.5", tag "!") or tagged as a string (!!str 0.5).
-bool is_quoted(const YAML::Node& node) {
-  return node.IsScalar() && (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str");
-}
-
-std::string describe(const YAML::Node& node) {
-  if (!node.IsDefined() || node.IsNull()) return "nothing";
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a mapping";
-  if (is_quoted(node)) return "the quoted text \"" + node.Scalar() + "\"";
-  return quote(node.Scalar());
-}
-
 double to_number(const Value& v) {
   double x = 0;
   if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<double>::decode(v.node, x) ||
@@ -165,26 +96,6 @@ bool to_bool(const Value& v) {
   if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<bool>::decode(v.node, x))
     fail(v.at, v.path + " must be true or false, found " + describe(v.node) + "; write true or false");
   return x;
-}
-
-std::string to_string(const Value& v) {
-  if (!v.node.IsScalar() || v.node.Scalar().empty())
-    fail(v.at, v.path + " must be text, found " + describe(v.node) + "; write a word such as left_condyle");
-  return v.node.Scalar();
-}
-
-std::vector<Value> to_list(const Value& v) {
-  std::vector<Value> items;
-  if (v.node.IsNull()) return items;
-  if (!v.node.IsSequence())
-    fail(v.at, v.path + " must be a list, found " + describe(v.node) + "; write one '- ...' line per entry");
-  for (size_t i = 0; i < v.node.size(); ++i) {
-    const YAML::Node item = v.node[i];
-    items.push_back({item,
-                     {v.at.file, item.Mark().line + 1, item.Mark().column + 1},
-                     v.path + "[" + std::to_string(i) + "]"});
-  }
-  return items;
 }
 
 // Coordinates and vectors in mm, each component within kMaxCoordinateMm (mesher/units.h).
@@ -258,71 +169,19 @@ double patch_radius(const Value& v, const std::string& unit_hint) {
   return r;
 }
 
-// A mapping whose keys are checked against the valid ones on construction (unknown and repeated keys
-// are errors at the key), with access by key.
-class Map {
- public:
-  Map(const Value& v, std::vector<std::string> valid) : at_(v.at), path_(v.path) {
-    if (v.node.IsNull()) return;  // "mesh:" with nothing after it reads as an empty mapping
-    if (!v.node.IsMap())
-      fail(v.at, what() + " must be a mapping of 'key: value' entries, found " + describe(v.node) +
-                     "; valid keys are " + join_quoted(valid));
-    for (auto it = v.node.begin(); it != v.node.end(); ++it) {
-      const SourceLocation key_at{at_.file, it->first.Mark().line + 1, it->first.Mark().column + 1};
-      if (!it->first.IsScalar())
-        fail(key_at, "a key of " + what() + " is not a plain word; write 'key: value'");
-      const std::string key = it->first.Scalar();
-      if (std::find(valid.begin(), valid.end(), key) == valid.end())
-        fail(key_at, "unknown key " + quote(key) + " in " + what() + "; " + suggestion(key, valid, "keys"));
-      if (const auto previous = entries_.find(key); previous != entries_.end())
-        fail(key_at, "key " + quote(key) + " appears twice in " + what() + " (first on line " +
-                         std::to_string(previous->second.key_at.line) + "); keep one");
-      // A null value ("key:" with nothing) carries the next line's mark; the key's mark is where it is.
-      const bool has_mark = !it->second.IsNull();
-      const SourceLocation value_at =
-          has_mark ? SourceLocation{at_.file, it->second.Mark().line + 1, it->second.Mark().column + 1}
-                   : key_at;
-      entries_.emplace(key, Entry{key_at, Value{it->second, value_at, child_path(key)}});
-    }
-  }
-
-  bool has(const std::string& key) const { return entries_.count(key) > 0; }
-  const Value& get(const std::string& key) const { return entries_.at(key).value; }
-  const SourceLocation& key_at(const std::string& key) const { return entries_.at(key).key_at; }
-  std::optional<Value> find(const std::string& key) const {
-    if (!has(key)) return std::nullopt;
-    return get(key);
-  }
-  const Value& require(const std::string& key, const std::string& example) const {
-    if (!has(key)) fail(at_, what() + " has no " + quote(key) + ", which is required; add e.g. " + example);
-    return get(key);
-  }
-  const SourceLocation& at() const { return at_; }
-  std::string what() const { return path_.empty() ? "the scenario" : path_; }
-
- private:
-  struct Entry {
-    SourceLocation key_at;
-    Value value;
-  };
-  std::string child_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
-  SourceLocation at_;
-  std::string path_;
-  std::map<std::string, Entry> entries_;
-};
-
-std::string resolve_file(const Ctx& ctx, const Value& v, const std::string& kind) {
+std::string resolve_file(const Source& ctx, const Value& v, const std::string& kind) {
   const std::string given = to_string(v);
   fs::path path(given);
-  if (path.is_relative()) path = ctx.folder / path;
+  // A path that a study set resolves against the study file's folder (yaml_input.h).
+  const fs::path folder = ctx.folder_of(v.node);
+  if (path.is_relative()) path = folder / path;
   path = path.lexically_normal();
   std::error_code error;
   if (!fs::is_regular_file(path, error))
     fail(v.at, kind + " file " + quote(given) +
                    (path.string() == given ? std::string() : " (resolved to " + quote(path.string()) + ")") +
-                   " does not exist or is not a file; give a path relative to the scenario file's folder or "
-                   "an absolute path");
+                   " does not exist or is not a file; give a path relative to the " +
+                   (folder == ctx.folder ? "scenario" : "study") + " file's folder or an absolute path");
   return path.string();
 }
 
@@ -331,7 +190,7 @@ const std::vector<std::pair<std::string, MandibleVariant>> kVariants = {
     {"edentulous", MandibleVariant::kEdentulous},
     {"atrophic", MandibleVariant::kAtrophic}};
 
-GeometrySpec parse_geometry(const Ctx& ctx, const Value& v) {
+GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
   const Map map(v, {"mandible", "surface", "ct"});
   GeometrySpec g;
   g.where = v.at;
@@ -388,7 +247,7 @@ GeometrySpec parse_geometry(const Ctx& ctx, const Value& v) {
   return g;
 }
 
-LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, const GeometrySpec& geometry) {
+LandmarkSpec parse_landmarks(const Source& ctx, const std::optional<Value>& v, const GeometrySpec& geometry) {
   LandmarkSpec l;
   // A landmark file lies in its surface's frame, so by default it shares the surface's unit.
   l.scale_to_mm = geometry.source == GeometrySource::kSurface ? geometry.scale_to_mm : 1.0;
@@ -407,14 +266,14 @@ LandmarkSpec parse_landmarks(const Ctx& ctx, const std::optional<Value>& v, cons
       fail(x->at, "landmarks.points must be a mapping 'name: [x, y, z]', found " + describe(x->node) +
                       "; write e.g. points: {implant_site: [0, -30, 20]}");
     for (auto it = x->node.begin(); x->node.IsMap() && it != x->node.end(); ++it) {
-      const SourceLocation key_at{ctx.file, it->first.Mark().line + 1, it->first.Mark().column + 1};
+      const SourceLocation key_at = ctx.locate(it->first, x->at);
       const std::string name = it->first.Scalar();
       for (const auto& earlier : l.points)
         if (earlier.name == name)
           fail(key_at, "point " + quote(name) + " is defined twice in landmarks.points (first on line " +
                            std::to_string(earlier.where.line) + "); rename or remove one");
-      const SourceLocation value_at{ctx.file, it->second.Mark().line + 1, it->second.Mark().column + 1};
-      l.points.push_back({name, to_vec3({it->second, value_at, "landmarks.points." + name}), key_at});
+      const SourceLocation value_at = ctx.locate(it->second, key_at);
+      l.points.push_back({name, to_vec3({&ctx, it->second, value_at, "landmarks.points." + name}), key_at});
     }
   }
   return l;
@@ -622,7 +481,7 @@ Muscle parse_muscle(const Value& item) {
 
 // activation_pattern: {base: a, base: {left: a, right: b}} becomes left_<base> and right_<base> muscles
 // with every other property from the landmarks.
-std::vector<Muscle> parse_activation_pattern(const Ctx& ctx, const Value& v) {
+std::vector<Muscle> parse_activation_pattern(const Source& ctx, const Value& v) {
   std::vector<Muscle> muscles;
   if (v.node.IsNull()) return muscles;
   if (!v.node.IsMap())
@@ -632,12 +491,10 @@ std::vector<Muscle> parse_activation_pattern(const Ctx& ctx, const Value& v) {
             describe(v.node) +
             "; write e.g. activation_pattern: {superficial_masseter: {left: 0.2, right: 0.56}}");
   for (auto it = v.node.begin(); it != v.node.end(); ++it) {
-    const SourceLocation key_at{ctx.file, it->first.Mark().line + 1, it->first.Mark().column + 1};
+    const SourceLocation key_at = ctx.locate(it->first, v.at);
     const std::string base = it->first.Scalar();
-    const SourceLocation value_at = it->second.IsNull() ? key_at
-                                                        : SourceLocation{ctx.file, it->second.Mark().line + 1,
-                                                                         it->second.Mark().column + 1};
-    const Value value{it->second, value_at, "activation_pattern." + base};
+    const SourceLocation value_at = it->second.IsNull() ? key_at : ctx.locate(it->second, key_at);
+    const Value value{&ctx, it->second, value_at, "activation_pattern." + base};
     // "right_superficial_masseter: 0.5" became left_right_superficial_masseter and
     // right_right_superficial_masseter, reported as muscles unknown to the landmarks.
     for (const char* side : {"left_", "right_"})
@@ -810,8 +667,27 @@ void check_loads_and_supports(const Scenario& s, const Map& root) {
          "by default); mark the biting patch with 'bite: true', or set outputs.bite_force: false");
 }
 
-Scenario parse_scenario(const Ctx& ctx, const YAML::Node& root_node) {
-  const Value root_value{root_node, {ctx.file, 1, 1}, ""};
+double distance(const Vec3& a, const Vec3& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+Vec3 quad_centroid(const QuadSurface& surface, const std::array<int, 4>& quad) {
+  Vec3 c{0, 0, 0};
+  for (int v : quad)
+    for (int k = 0; k < 3; ++k) c[k] += 0.25 * surface.vertices[v][k];
+  return c;
+}
+
+}  // namespace
+
+Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
+  const SourceLocation top{ctx.file, 1, 1, ctx.note};
+  if (!root_node.IsDefined() || root_node.IsNull())
+    fail(top,
+         "the scenario file is empty; it needs at least 'name', 'geometry', 'muscles' and 'supports' "
+         "(see docs/scenario-format.md)");
+  const Value root_value{&ctx, root_node, top, ""};
   if (!root_node.IsMap())
     fail(root_value.at, "a scenario must be a mapping of 'key: value' entries starting with 'name:', found " +
                             describe(root_node) + "; see docs/scenario-format.md");
@@ -861,138 +737,10 @@ Scenario parse_scenario(const Ctx& ctx, const YAML::Node& root_node) {
   return s;
 }
 
-double distance(const Vec3& a, const Vec3& b) {
-  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                   (a[2] - b[2]) * (a[2] - b[2]));
-}
-
-Vec3 quad_centroid(const QuadSurface& surface, const std::array<int, 4>& quad) {
-  Vec3 c{0, 0, 0};
-  for (int v : quad)
-    for (int k = 0; k < 3; ++k) c[k] += 0.25 * surface.vertices[v][k];
-  return c;
-}
-
-// Where the innermost '[' or '{' that is still open at yaml-cpp's mark was opened, or nothing. yaml-cpp
-// reports an unclosed flow collection ("end of sequence flow not found") at the token that should have been
-// ',' or ']', usually on a later line; the user needs the line of the bracket. The scan skips comments and
-// quoted text, and takes a bracket outside any flow collection as an opener only where a value can begin
-// (at the start of a line or after ': ', '- ', '? '), so that '[' inside plain text ("note: see [1") is not
-// counted. Block scalars ('|', '>') are not recognized: a bracket at the start of one of their lines would be
-// taken for an opener, which is why the caller checks the bracket's kind and still names yaml-cpp's place.
-std::optional<std::pair<SourceLocation, char>> unclosed_flow_opener(const std::string& text,
-                                                                    const YAML::Mark& mark,
-                                                                    const std::string& file) {
-  struct Open {
-    int line, column;
-    char bracket;
-  };
-  std::vector<Open> open;
-  int line = 0, column = 0;
-  char quote = 0;     // the quote of the quoted scalar we are in, or 0
-  char previous = 0;  // the last character on this line that is not a space (0: none yet)
-  bool space = true;  // the character before is a space, a tab or the start of the line
-  // A quoted scalar or a flow collection may begin here: at the start of a line, after ': ', '- ' or '? '
-  // outside flow collections, and after '[', '{', ',', ':' or '?' inside one.
-  const auto value_can_begin = [&] {
-    if (previous == 0) return true;
-    if (open.empty()) return space && std::strchr(":-?", previous) != nullptr;
-    return std::strchr("[{,:?", previous) != nullptr;
-  };
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if (line > mark.line || (line == mark.line && column >= mark.column)) break;
-    const char c = text[i];
-    if (c == '\n') {
-      ++line, column = 0, previous = 0, space = true;
-      continue;
-    }
-    if (quote == '"' && c == '\\') {  // an escape: skip the escaped character (not a newline)
-      if (i + 1 < text.size() && text[i + 1] != '\n') ++i, ++column;
-    } else if (quote == '\'' && c == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
-      ++i, ++column;  // '' is a quote inside single quotes
-    } else if (quote != 0) {
-      if (c == quote) quote = 0;
-    } else if (c == '#' && space) {
-      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
-      continue;  // the newline resets the line's state
-    } else if ((c == '"' || c == '\'') && value_can_begin()) {
-      quote = c;
-    } else if ((c == '[' || c == '{') && (!open.empty() || value_can_begin())) {
-      open.push_back({line, column, c});
-    } else if ((c == ']' || c == '}') && !open.empty() && open.back().bracket == (c == ']' ? '[' : '{')) {
-      open.pop_back();
-    }
-    if (c != ' ' && c != '\t') previous = c;
-    space = c == ' ' || c == '\t';
-    ++column;
-  }
-  if (open.empty()) return std::nullopt;
-  return std::make_pair(SourceLocation{file, open.back().line + 1, open.back().column + 1},
-                        open.back().bracket);
-}
-
-// The place of the first tab in the indentation (the blanks that start a line) of the lines up to
-// `last_line` (0-based), or nothing.
-std::optional<SourceLocation> indenting_tab(const std::string& text, int last_line, const std::string& file) {
-  int line = 0, column = 0;
-  bool indenting = true;
-  for (const char c : text) {
-    if (line > last_line) break;
-    if (c == '\n') {
-      ++line, column = 0, indenting = true;
-      continue;
-    }
-    if (indenting && c == '\t') return SourceLocation{file, line + 1, column + 1};
-    if (c != ' ') indenting = false;
-    ++column;
-  }
-  return std::nullopt;
-}
-
-}  // namespace
-
 Scenario load_scenario(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in || fs::is_directory(path))
-    throw InputError("cannot read scenario file '" + path + "'; check the path (scenarios are YAML files)");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::vector<YAML::Node> documents;
-  try {
-    documents = YAML::LoadAll(text.str());
-  } catch (const YAML::Exception& e) {
-    const SourceLocation where{path, e.mark.line + 1, e.mark.column + 1};
-    // An unclosed '[' or '{': named where it opened, not where yaml-cpp noticed (often a later line).
-    const bool sequence = e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW;
-    if (sequence || e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW)
-      if (const auto opener = unclosed_flow_opener(text.str(), e.mark, path);
-          opener && opener->second == (sequence ? '[' : '{'))
-        fail(opener->first, std::string("YAML syntax error: this '") + opener->second + "' is not closed (" +
-                                e.msg + ", noticed at line " + std::to_string(where.line) + ", column " +
-                                std::to_string(where.column) + "); add the '" + (sequence ? ']' : '}') +
-                                "' that closes it, and check the commas between its entries");
-    // A tab in the indentation (an editor's, or text pasted from elsewhere) is no YAML; yaml-cpp reports
-    // whatever it makes of the line after it ("illegal map value"), which does not say so.
-    if (const auto tab = indenting_tab(text.str(), e.mark.line, path))
-      fail(*tab, "YAML syntax error: this line is indented with a tab, which YAML does not allow (" + e.msg +
-                     ", noticed at line " + std::to_string(where.line) + ", column " +
-                     std::to_string(where.column) + "); indent with spaces");
-    fail(where,
-         "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets near this place");
-  }
-  // Two scenarios pasted into one file: the second would be ignored without a word.
-  for (size_t i = 1; i < documents.size(); ++i)
-    if (!documents[i].IsNull())
-      fail({path, documents[i].Mark().line + 1, 1},
-           "a second YAML document starts here (after a '---' line); a scenario file holds one scenario: "
-           "put each scenario in its own file");
-  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
-  const Ctx ctx{path, fs::path(path).parent_path()};
-  if (!root.IsDefined() || root.IsNull())
-    fail({path, 1, 1},
-         "the scenario file is empty; it needs at least 'name', 'geometry', 'muscles' and 'supports' "
-         "(see docs/scenario-format.md)");
-  return parse_scenario(ctx, root);
+  const std::string text = read_yaml_text(path, "scenario");
+  const Source source{path, fs::path(path).parent_path(), "", {}};
+  return parse_scenario_tree(parse_yaml_document(text, path, "scenario"), source);
 }
 
 void resolve_points(Scenario& s, const Landmarks& landmarks) {

@@ -19,11 +19,15 @@ namespace hexbite {
 
 // Where something was written in a scenario file; line and column count from 1.
 struct SourceLocation {
-  std::string file;  // the scenario path as given to load_scenario()
+  std::string file;  // the scenario path as given to load_scenario() (or a study file, scenarios/study.h)
   int line = 0;
   int column = 0;
+  // What the place belongs to when the file alone does not say it: a study's variant ("variant
+  // 'soft_bone'"). Empty for a scenario run on its own.
+  std::string note;
 
-  std::string str() const;  // "FILE:LINE:COLUMN", the prefix of every scenario error message
+  // "FILE:LINE:COLUMN", or "FILE:LINE:COLUMN: NOTE": the prefix of every scenario error message.
+  std::string str() const;
 };
 
 // A point in millimetres, written either as coordinates [x, y, z] or as a name: a landmark, an extra
@@ -176,6 +180,7 @@ struct Scenario {
 
 // Reads and validates a scenario file. Everything that can be checked without the geometry is checked
 // here (keys, types, ranges, duplicate names, supports); throws InputError "FILE:LINE:COLUMN: ...".
+// (A study's variants are validated the same way from their merged trees: scenarios/study.h.)
 Scenario load_scenario(const std::string& path);
 
 // Turns every named point into coordinates using `landmarks` and the scenario's extra points, fills in

@@ -40,6 +40,44 @@ TEST(OutputStage, CommitMovesTheSetInAndRemovesTheEarlierRunsOtherOutputs) {
   EXPECT_EQ(test::files_under(dir), expected);
 }
 
+// Names in folders (a study's variants, "v1/out_a"): the folder is made when missing, the earlier run's
+// outputs in it are retired by their relative names, and a failure removes the folders the commit made.
+TEST(OutputStage, NamesInFoldersAreCommittedAndUndoneWithTheirFolders) {
+  const std::string dir = test::temp_dir();
+  fs::create_directory(dir + "/v1");
+  test::write_file(dir + "/v1/out_stale", "old stale\n");
+  test::write_file(dir + "/v1/notes.txt", "mine\n");
+  const auto in_folder_output = [](const std::string& name) {
+    return name.find('/') != std::string::npos && is_output(name.substr(name.find('/') + 1));
+  };
+  {
+    OutputStage stage(dir);
+    for (const char* name : {"v1", "v2"}) fs::create_directory(stage.stage_dir() + "/" + name);
+    test::write_file(stage.stage_dir() + "/v1/out_a", "new v1\n");
+    test::write_file(stage.stage_dir() + "/v2/out_a", "new v2\n");
+    stage.commit({"v1/out_a", "v2/out_a"}, in_folder_output);
+  }
+  const std::map<std::string, std::string> expected = {{"v1", "<folder>"},
+                                                       {"v1/out_a", "new v1\n"},
+                                                       {"v1/notes.txt", "mine\n"},
+                                                       {"v2", "<folder>"},
+                                                       {"v2/out_a", "new v2\n"}};
+  EXPECT_EQ(test::files_under(dir), expected);
+
+  // v3's file is missing from the stage: v1's file returns, and the folder v2b that the commit made goes.
+  {
+    OutputStage stage(dir);
+    for (const char* name : {"v1", "v2b"}) fs::create_directory(stage.stage_dir() + "/" + name);
+    test::write_file(stage.stage_dir() + "/v1/out_a", "newer v1\n");
+    test::write_file(stage.stage_dir() + "/v2b/out_a", "new v2b\n");
+    const std::string message = test::message_of<RunError>([&] {
+      stage.commit({"v1/out_a", "v2b/out_a", "v3/out_a"}, in_folder_output);
+    });
+    EXPECT_NE(message.find("v3/out_a"), std::string::npos) << message;
+  }
+  EXPECT_EQ(test::files_under(dir), expected);
+}
+
 // The last file's name is taken by a folder: the files already moved go back, the earlier ones return.
 TEST(OutputStage, AFolderInTheWayOfTheLastFileLeavesTheFolderAsItWas) {
   const std::string dir = test::temp_dir();

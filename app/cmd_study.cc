@@ -1,0 +1,181 @@
+// hexbite study STUDY.yaml -o DIR [--levels N] [--json]
+//
+// A what-if study as one command (docs/studies.md): every variant of the study's base scenario runs the
+// whole pipeline of `hexbite run` and gets its own run folder DIR/<variant>/, and DIR/study.json,
+// study.csv and study.md compare the variants with the first one.
+//
+// Every variant is checked before the first solve: the study file and each variant's scenario when the
+// study is loaded (scenarios/study.h), then each variant's geometry, meshes and patches (prepare_run), so a
+// bad value in the last variant costs no solve. All or nothing: the variants' folders and the tables are
+// written into one hidden stage folder in DIR (common/output_stage.h) and moved into DIR only when every
+// variant has solved and passed the checks of `hexbite run` (equilibrium, small displacements); any failure
+// leaves DIR as it was. One process only: under mpirun it is refused.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/commands.h"
+#include "app/option_checks.h"
+#include "app/run_outputs.h"
+#include "app/run_pipeline.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "common/output_stage.h"
+#include "common/progress.h"
+#include "postprocess/study_table.h"
+#include "scenarios/study.h"
+#include "solver/mpi_session.h"
+
+namespace hexbite {
+
+namespace {
+
+struct StudyCliOptions {
+  std::string study;
+  std::string output;
+  std::optional<int> levels;
+  bool json = false;
+};
+
+// Runs `step` for a variant: an error that does not name the variant yet (a mesh that stayed inverted, a
+// solver that failed) is prefixed with it, keeping its kind (exit code).
+template <class F>
+void for_variant(const StudyVariant& variant, const std::string& study_file, F step) {
+  const auto named = [&](const std::string& message) {
+    const std::string note = "variant '" + variant.name + "'";
+    return message.find(note) != std::string::npos ? message
+                                                   : note + " of study " + study_file + ": " + message;
+  };
+  try {
+    step();
+  } catch (const InputError& e) {
+    throw InputError(named(e.what()));
+  } catch (const RunError& e) {
+    throw RunError(named(e.what()));
+  }
+}
+
+// The row of study.json of a solved variant: the figures of its finest level.
+StudyRow study_row(const StudyVariant& variant, const RunResult& r) {
+  const LevelResult& finest = r.levels.back();
+  const ElasticitySolution& u = finest.solution;
+  StudyRow row;
+  row.name = variant.name;
+  row.set = variant.set;
+  row.level = finest.level;
+  row.hexes = static_cast<long long>(finest.mesh.hexes.size());
+  if (r.scenario.outputs.bite_force) row.bite_force_N = u.bite_force;
+  row.max_displacement_mm = u.max_displacement;
+  row.von_mises_max_MPa = u.von_mises_max;
+  row.von_mises_p99_MPa = u.von_mises_p99;
+  row.strain_energy_mJ = u.strain_energy;
+  for (const SupportReaction& reaction : u.reactions)
+    row.reactions.emplace_back(reaction.name, reaction.magnitude);
+  return row;
+}
+
+void run_study(const StudyCliOptions& o) {
+  // Each variant would be distributed on its own; the study's stage and tables are one process's work.
+  if (MpiSession::size() > 1)
+    throw InputError(
+        "hexbite study runs on one process, not under mpirun; run it without mpirun, or run a "
+        "variant's scenario with mpirun hexbite run");
+  const auto start = std::chrono::steady_clock::now();
+  Study study = load_study(o.study);
+  const std::size_t count = study.variants.size();
+  const auto counted = [&](std::size_t i) {
+    return std::to_string(i + 1) + " / " + std::to_string(count) + ": " + study.variants[i].name;
+  };
+
+  // Everything the input decides, for every variant, before the first solve.
+  std::vector<RunResult> runs;
+  for (std::size_t i = 0; i < count; ++i) {
+    StudyVariant& v = study.variants[i];
+    info("check variant " + counted(i));
+    for_variant(v, study.path, [&] {
+      if (v.scenario.outputs.inp) check_inp_exportable(v.scenario);
+      const int levels = o.levels ? *o.levels : v.scenario.mesh.validation_levels;
+      runs.push_back(prepare_run(v.scenario, levels));
+    });
+  }
+
+  // The whole study is staged in DIR and moved in only when complete.
+  OutputStage stage(o.output);
+  const std::string left =
+      stage.created_dir() ? "did not create '" + stage.dir() + "'" : "left '" + stage.dir() + "' as it was";
+  StudyTable table{study.name, study.path, study.base, {}};
+  std::vector<std::string> files;
+  try {
+    for (std::size_t i = 0; i < count; ++i) {
+      const StudyVariant& v = study.variants[i];
+      RunResult& r = runs[i];
+      info("variant " + counted(i));
+      for_variant(v, study.path, [&] {
+        solve_run(r);
+        // The variant's run folder, exactly as `hexbite run` writes it (app/cmd_run.cc).
+        const auto t = std::chrono::steady_clock::now();
+        RunOutputs outputs(stage.stage_dir() + "/" + v.name);
+        const std::vector<std::string> written = outputs.write(r, r.scenario.outputs.inp);
+        const nlohmann::ordered_json results = results_json(r, seconds_since(t));
+        outputs.commit(results.dump(2) + '\n');
+        for (const std::string& f : written) files.push_back(v.name + "/" + f);
+        files.push_back(v.name + "/results.json");
+        require_trustworthy(r, "the results of variant '" + v.name + "'");
+      });
+      table.rows.push_back(study_row(v, r));
+      r = RunResult();  // the solution is written: free its memory for the next variant
+    }
+    const nlohmann::ordered_json j = study_json(table);
+    write_file_atomically(stage.stage_dir() + "/study.csv", study_csv(j));
+    write_file_atomically(stage.stage_dir() + "/study.md", study_markdown(j));
+    write_file_atomically(stage.stage_dir() + "/study.json", j.dump(2) + '\n');
+    for (const char* name : {"study.csv", "study.md", "study.json"}) files.push_back(name);  // json last
+    // An earlier study's output files in a variant's folder that this one does not rewrite go; the tables
+    // are always rewritten, and everything else (other folders, your own files) stays.
+    stage.commit(files, [](const std::string& name) {
+      const std::size_t slash = name.find('/');
+      return slash != std::string::npos && is_run_output_name(name.substr(slash + 1));
+    });
+
+    if (o.json) {
+      std::cout << j.dump(2) << '\n';
+    } else if (!is_quiet()) {
+      char total[64];
+      std::snprintf(total, sizeof total, "%.1f", seconds_since(start));
+      std::cout << "Study " << study.name << " (" << study.path << "), base " << study.base << ", " << count
+                << " variant" << (count == 1 ? "" : "s") << "\n\n"
+                << study_markdown(j) << "\nwrote in " << stage.dir()
+                << ": study.json, study.csv, study.md and a run folder per variant (" << total
+                << " s in all)\n";
+    }
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + "; the study kept none of its files and " + left);
+  } catch (const RunError& e) {
+    throw RunError(std::string(e.what()) + "; the study kept none of its files and " + left);
+  }
+}
+
+}  // namespace
+
+void add_study_command(CLI::App& app) {
+  auto o = std::make_shared<StudyCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "study", "Run a what-if study: a base scenario and its variants, each a full run, compared in tables");
+  cmd->add_option("study", o->study, "Study file (.yaml), see docs/studies.md")->required();
+  cmd->add_option("-o,--output", o->output, "Output folder (created if missing)")
+      ->required()
+      ->check(output_folder());
+  cmd->add_option("--levels", o->levels,
+                  "Validation levels of every variant (each refines the mesh 8-way and solves again); "
+                  "overrides the scenarios' mesh.validation_levels")
+      ->check(CLI::Range(0, 3));
+  cmd->add_flag("--json", o->json, "Print study.json instead of the table");
+  cmd->callback([o] { run_study(*o); });
+}
+
+}  // namespace hexbite

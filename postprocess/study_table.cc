@@ -1,0 +1,170 @@
+#include "postprocess/study_table.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iterator>
+#include <sstream>
+
+#include "common/number_format.h"
+
+namespace hexbite {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+// The figures of a row, their column labels and the decimals `hexbite run` prints them with.
+struct Figure {
+  const char* key;
+  const char* label;
+  int decimals;
+};
+const Figure kFigures[] = {{"bite_force_N", "bite force (N)", 2},
+                           {"max_displacement_mm", "max displacement (mm)", 5},
+                           {"von_mises_max_MPa", "von Mises max (MPa)", 3},
+                           {"von_mises_p99_MPa", "von Mises p99 (MPa)", 3},
+                           {"strain_energy_mJ", "strain energy (mJ)", 5}};
+
+json relative(const json& value, const json& reference) {
+  if (!value.is_number() || !reference.is_number() || reference.get<double>() == 0.0) return json();
+  return (value.get<double>() - reference.get<double>()) / std::abs(reference.get<double>());
+}
+
+// The supports of all variants, in the order they first appear (a variant may add or rename one).
+std::vector<std::string> support_names(const json& study) {
+  std::vector<std::string> names;
+  for (const json& v : study["variants"])
+    for (const auto& [name, magnitude] : v["reactions"].items())
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  return names;
+}
+
+// The reaction of `support` in a row of study.json, or null.
+json reaction(const json& row, const std::string& support) {
+  return row["reactions"].contains(support) ? row["reactions"][support] : json();
+}
+
+// A variant's changes on one line: "path: value; path: value". With `abbreviate` (Markdown), a mapping or
+// list longer than a table cell stands as "{...}" or "[...]": study.csv and study.json give it whole.
+std::string changes(const json& set, bool abbreviate) {
+  std::string out;
+  for (const auto& [path, value] : set.items()) {
+    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
+    out += (out.empty() ? "" : "; ") + path + ": " + text;
+  }
+  return out;
+}
+
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string csv_number(const json& value) {
+  return value.is_number() ? value.dump() : "";
+}
+
+std::string markdown_cell(std::string text) {
+  for (std::size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2))
+    text.replace(at, 1, "\\|");
+  return text;
+}
+
+// "362.04", or "362.04 (-1.4 %)" with the relative change; "—" for a missing figure.
+std::string markdown_figure(const json& value, const json& change, int decimals) {
+  if (!value.is_number()) return "—";
+  std::string text = format_table_number(value.get<double>(), decimals, 0);
+  if (change.is_number()) {
+    // One decimal: a report compares variants by per cent, and the round-off of equal figures (1e-13 %)
+    // reads as 0.0 %; study.csv and study.json keep every digit.
+    const double percent = 100.0 * change.get<double>();
+    char cell[64];
+    std::snprintf(cell, sizeof cell, std::abs(percent) < 0.05 ? " (0.0 %%)" : " (%+.1f %%)", percent);
+    text += cell;
+  }
+  return text;
+}
+
+}  // namespace
+
+json study_json(const StudyTable& table) {
+  json variants = json::array();
+  for (const StudyRow& row : table.rows) {
+    json reactions = json::object();
+    for (const auto& [name, magnitude] : row.reactions) reactions[name] = magnitude;
+    variants.push_back({{"name", row.name},
+                        {"set", row.set},
+                        {"level", row.level},
+                        {"hexes", row.hexes},
+                        {"bite_force_N", row.bite_force_N ? json(*row.bite_force_N) : json()},
+                        {"max_displacement_mm", row.max_displacement_mm},
+                        {"von_mises_max_MPa", row.von_mises_max_MPa},
+                        {"von_mises_p99_MPa", row.von_mises_p99_MPa},
+                        {"strain_energy_mJ", row.strain_energy_mJ},
+                        {"reactions", reactions}});
+  }
+  for (json& v : variants) {
+    const json& reference = variants.front();
+    json change = json::object();
+    for (const Figure& f : kFigures) change[f.key] = relative(v[f.key], reference[f.key]);
+    json reactions = json::object();
+    for (const auto& [name, magnitude] : v["reactions"].items())
+      reactions[name] = relative(magnitude, reaction(reference, name));
+    change["reactions"] = reactions;
+    v["relative_to_reference"] = change;
+  }
+  return {
+      {"study", table.study}, {"study_file", table.study_file}, {"base", table.base}, {"variants", variants}};
+}
+
+std::string study_csv(const json& study) {
+  const std::vector<std::string> supports = support_names(study);
+  std::ostringstream out;
+  out << "variant,set,level,hexes";
+  for (const Figure& f : kFigures) out << ',' << f.key;
+  for (const std::string& s : supports) out << ',' << csv_field("reaction_" + s + "_N");
+  for (const Figure& f : kFigures) out << ',' << f.key << "_relative";
+  out << '\n';
+  for (const json& v : study["variants"]) {
+    out << csv_field(v["name"].get<std::string>()) << ',' << csv_field(changes(v["set"], false)) << ','
+        << v["level"].dump() << ',' << v["hexes"].dump();
+    for (const Figure& f : kFigures) out << ',' << csv_number(v[f.key]);
+    for (const std::string& s : supports) out << ',' << csv_number(reaction(v, s));
+    for (const Figure& f : kFigures) out << ',' << csv_number(v["relative_to_reference"][f.key]);
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::string study_markdown(const json& study) {
+  const std::vector<std::string> supports = support_names(study);
+  const json& variants = study["variants"];
+  std::ostringstream out;
+  out << "| variant | changes | level | hexes |";
+  for (const Figure& f : kFigures) out << ' ' << f.label << " |";
+  for (const std::string& s : supports) out << " reaction " << markdown_cell(s) << " (N) |";
+  out << "\n|---|---|---:|---:|";
+  for (std::size_t i = 0; i < std::size(kFigures) + supports.size(); ++i) out << "---:|";
+  out << '\n';
+  for (std::size_t i = 0; i < variants.size(); ++i) {
+    const json& v = variants[i];
+    const json& change = v["relative_to_reference"];
+    const bool reference = i == 0;  // its changes against itself are zero: shown without them
+    const std::string set = changes(v["set"], true);
+    out << "| " << markdown_cell(v["name"].get<std::string>()) << " | "
+        << (set.empty() ? "(none)" : "`" + markdown_cell(set) + "`") << " | " << v["level"].dump() << " | "
+        << v["hexes"].dump() << " |";
+    for (const Figure& f : kFigures)
+      out << ' ' << markdown_figure(v[f.key], reference ? json() : change[f.key], f.decimals) << " |";
+    for (const std::string& s : supports)
+      out << ' ' << markdown_figure(reaction(v, s), reference ? json() : reaction(change, s), 2) << " |";
+    out << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace hexbite

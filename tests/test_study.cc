@@ -1,0 +1,297 @@
+// hexbite study: a base scenario and its variants as one command. The comparison tables obey linear
+// elasticity (half the Young's modulus, twice the displacements and strain energy, the same stresses and
+// reactions on the same mesh), the three tables agree, a variant's run folder is what `hexbite run` writes,
+// bad studies stop at the study's line before anything is written, and a failed variant leaves the output
+// folder as it was. A 20 mm cube of a few hundred hexes keeps every solve well under a second.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/error.h"
+#include "scenarios/study.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// The base scenario, in its own folder (base/cube.yaml beside base/cube.obj): a cube held at x = 0 (the
+// "bite", so that there is a bite force) and pulled down at x = 20.
+const std::string kBase = R"(name: cube_pull
+geometry:
+  surface: {file: cube.obj}
+mesh: {target_hexes: 300, validation_levels: 0}
+muscles:
+  - {name: pull, activation: 1, insertion: [20, 10, 10], radius_mm: 6, direction: [0, 0, -1], max_force_N: 100}
+supports:
+  - {name: base, at: [0, 10, 10], radius_mm: 6, bite: true}
+materials:
+  default: {E_MPa: 11000, poisson: 0.28}
+)";
+
+const std::string kStudy = R"(name: stiffness what-if
+base: base/cube.yaml
+variants:
+  - name: reference
+  - name: soft
+    set:
+      materials.default.E_MPa: 5500
+  - name: no_bite
+    set:
+      supports.base.bite: false
+      outputs: {bite_force: false}
+)";
+
+// A fresh folder with base/cube.yaml, base/cube.obj and study.yaml holding `study`; returns the folder.
+std::string study_folder(const std::string& study) {
+  const std::string dir = test::temp_dir();
+  fs::create_directories(dir + "/base");
+  test::write_file(dir + "/base/cube.yaml", kBase);
+  test::write_file(dir + "/base/cube.obj", test::cubes_obj(1));
+  test::write_file(dir + "/study.yaml", study);
+  return dir;
+}
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::stringstream in(text);
+  for (std::string part; std::getline(in, part, separator);) parts.push_back(part);
+  return parts;
+}
+
+// kStudy run once for the tests that read its outputs.
+class CubeStudy : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(study_folder(kStudy));
+    const test::CommandResult r = test::run_hexbite({"study", *dir_ + "/study.yaml", "-o", *dir_ + "/out"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    out_ = new std::string(r.out);
+    study_ = new json(json::parse(test::read_file(*dir_ + "/out/study.json")));
+  }
+  static const json& variant(const std::string& name) {
+    for (const json& v : (*study_)["variants"])
+      if (v["name"] == name) return v;
+    throw std::runtime_error("no variant " + name);
+  }
+  static std::string* dir_;
+  static std::string* out_;
+  static json* study_;
+};
+std::string* CubeStudy::dir_ = nullptr;
+std::string* CubeStudy::out_ = nullptr;
+json* CubeStudy::study_ = nullptr;
+
+TEST_F(CubeStudy, HalfTheModulusDoublesDisplacementAndEnergyAndKeepsStressesAndForces) {
+  const json& ref = variant("reference");
+  const json& soft = variant("soft");
+  EXPECT_EQ(ref["hexes"], soft["hexes"]);  // the same mesh: the material does not change the meshing
+  // Linear elasticity on one mesh with zero prescribed displacements: u scales with 1/E exactly, the
+  // strains with it, the stresses and reactions not at all.
+  const auto ratio = [&](const char* key) { return soft[key].get<double>() / ref[key].get<double>(); };
+  EXPECT_NEAR(ratio("max_displacement_mm"), 2.0, 2e-6);
+  EXPECT_NEAR(ratio("strain_energy_mJ"), 2.0, 2e-6);
+  EXPECT_NEAR(ratio("von_mises_max_MPa"), 1.0, 1e-6);
+  EXPECT_NEAR(ratio("von_mises_p99_MPa"), 1.0, 1e-6);
+  EXPECT_NEAR(ratio("bite_force_N"), 1.0, 1e-6);
+  EXPECT_NEAR(soft["reactions"]["base"].get<double>() / ref["reactions"]["base"].get<double>(), 1.0, 1e-6);
+  // The muscle pulls 100 N; the only support takes all of it.
+  EXPECT_NEAR(ref["bite_force_N"].get<double>(), 100.0, 1e-6);
+  EXPECT_NEAR(soft["relative_to_reference"]["max_displacement_mm"].get<double>(), 1.0, 2e-6);
+  EXPECT_NEAR(soft["relative_to_reference"]["von_mises_max_MPa"].get<double>(), 0.0, 1e-6);
+  EXPECT_EQ(ref["relative_to_reference"]["strain_energy_mJ"].get<double>(), 0.0);
+  EXPECT_EQ(soft["set"], json::parse(R"({"materials.default.E_MPa": 5500})"));
+}
+
+TEST_F(CubeStudy, AVariantWithoutABiteHasNoBiteForceInAnyTable) {
+  EXPECT_TRUE(variant("no_bite")["bite_force_N"].is_null());
+  EXPECT_TRUE(variant("no_bite")["relative_to_reference"]["bite_force_N"].is_null());
+  const std::vector<std::string> rows = split(test::read_file(*dir_ + "/out/study.csv"), '\n');
+  ASSERT_EQ(rows.size(), 4u);
+  const std::vector<std::string> header = split(rows[0], ',');
+  const auto column = [&](const std::string& name) {
+    return std::find(header.begin(), header.end(), name) - header.begin();
+  };
+  EXPECT_EQ(split(rows[3], ',')[column("bite_force_N")], "");
+  const std::string md = test::read_file(*dir_ + "/out/study.md");
+  EXPECT_NE(md.find("| no_bite | `supports.base.bite: false; outputs: {\"bite_force\":false}` | 0 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| — |"), std::string::npos) << md;
+}
+
+TEST_F(CubeStudy, CsvMarkdownAndJsonAgree) {
+  const std::vector<std::string> rows = split(test::read_file(*dir_ + "/out/study.csv"), '\n');
+  ASSERT_EQ(rows.size(), 4u);
+  const std::vector<std::string> header = split(rows[0], ',');
+  const std::string md = test::read_file(*dir_ + "/out/study.md");
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const std::vector<std::string> cells = split(rows[i], ',');
+    ASSERT_EQ(cells.size(), header.size()) << rows[i];
+    const json& v = (*study_)["variants"][i - 1];
+    EXPECT_EQ(cells[0], v["name"].get<std::string>());
+    for (const char* key :
+         {"max_displacement_mm", "von_mises_max_MPa", "von_mises_p99_MPa", "strain_energy_mJ"}) {
+      const auto at = std::find(header.begin(), header.end(), key) - header.begin();
+      EXPECT_EQ(std::stod(cells[at]), v[key].get<double>()) << key;  // the same number, all its digits
+    }
+    const auto reaction = std::find(header.begin(), header.end(), "reaction_base_N") - header.begin();
+    EXPECT_EQ(std::stod(cells[reaction]), v["reactions"]["base"].get<double>());
+    // The Markdown row shows the figures rounded as hexbite run prints them.
+    char displacement[64];
+    std::snprintf(displacement, sizeof displacement, "%.5f", v["max_displacement_mm"].get<double>());
+    EXPECT_NE(md.find("| " + v["name"].get<std::string>() + " |"), std::string::npos) << md;
+    EXPECT_NE(md.find(displacement), std::string::npos) << displacement << '\n' << md;
+  }
+  EXPECT_NE(md.find("(+100.0 %)"), std::string::npos) << md;  // soft's displacement against the reference
+  EXPECT_NE(out_->find(md), std::string::npos) << *out_;      // printed at the end
+}
+
+// A variant's folder is the run folder that `hexbite run` writes for the same scenario: the same files, the
+// VTU files byte for byte, results.json apart from its timings.
+TEST_F(CubeStudy, AVariantsFolderIsWhatHexbiteRunWrites) {
+  const std::string run_dir = *dir_ + "/run_reference";
+  const test::CommandResult r = test::run_hexbite({"-q", "run", *dir_ + "/base/cube.yaml", "-o", run_dir});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto study_files = test::files_under(*dir_ + "/out/reference");
+  auto run_files = test::files_under(run_dir);
+  const auto without_timings = [](const std::string& text) {
+    json j = json::parse(text);
+    j.erase("seconds");
+    j["solver"].erase("seconds");
+    for (json& level : j["validation"]["levels"]) level["solver"].erase("seconds");
+    return j;
+  };
+  EXPECT_EQ(without_timings(study_files["results.json"]), without_timings(run_files["results.json"]));
+  study_files.erase("results.json");
+  run_files.erase("results.json");
+  test::expect_same_files(run_files, study_files);
+  EXPECT_EQ(json::parse(test::read_file(*dir_ + "/out/soft/results.json"))["max_displacement_mm"],
+            variant("soft")["max_displacement_mm"]);
+}
+
+// A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
+void expect_refused(const std::string& study, int line, const std::string& message) {
+  const std::string dir = study_folder(study);
+  const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:" + std::to_string(line) + ":"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out")) << r.err;
+}
+
+// kStudy with its soft variant's set line replaced by `set_line`.
+std::string soft_setting(const std::string& set_line) {
+  std::string study = kStudy;
+  study.replace(study.find("materials.default.E_MPa: 5500"), 29, set_line);
+  return study;
+}
+
+TEST(Study, UnknownKeyOnThePathIsRefusedWithTheKeysThere) {
+  expect_refused(
+      soft_setting("materials.defualt.E_MPa: 5500"), 7,
+      "variant 'soft': set 'materials.defualt.E_MPa': 'materials' has no key 'defualt' (a path may "
+      "add only its last key); did you mean 'default'? (the keys there are 'default')");
+}
+
+TEST(Study, UnknownListItemIsRefusedWithTheNamesThere) {
+  expect_refused(soft_setting("supports.bsae.at: [0, 10, 12]"), 7,
+                 "'supports' has no item named 'bsae' (list items are addressed by their name); did you mean "
+                 "'base'? (the names are 'base')");
+}
+
+TEST(Study, DuplicateVariantNameIsRefused) {
+  std::string study = kStudy;
+  study.replace(study.find("name: no_bite"), 13, "name: soft");
+  expect_refused(study, 8, "variant 'soft' is defined twice (first on line 5)");
+}
+
+TEST(Study, InvalidOverriddenValueIsNamedAtTheStudysLine) {
+  expect_refused(soft_setting("materials.default.E_MPa: -5"), 7,
+                 "variant 'soft': materials.default.E_MPa is -5 MPa but Young's modulus must be positive");
+}
+
+// A point name is checked once the geometry exists, still before the first solve of any variant.
+TEST(Study, UnknownPointOfTheLastVariantStopsTheStudyBeforeAnySolve) {
+  std::string study = kStudy + "  - name: lost\n    set:\n      supports.base.at: nowhere\n";
+  expect_refused(study, 14, "unknown point name 'nowhere'");
+}
+
+TEST(Study, UnknownKeyAndUnsafeVariantNameAreRefused) {
+  expect_refused(kStudy + "varients: []\n", 12,
+                 "unknown key 'varients' in the study; did you mean 'variants'?");
+  std::string study = kStudy;
+  study.replace(study.find("name: no_bite"), 13, "name: ../up");
+  expect_refused(study, 8, "variant name '../up' is not a safe folder name");
+}
+
+// Values the study set are named at the study's line and resolve paths from its folder; the rest of the
+// variant is the base scenario's, named at its lines and resolving from its folder.
+TEST(Study, PlacesAndRelativePathsFollowTheFileTheyWereWrittenIn) {
+  std::string text = kStudy;
+  text.replace(text.find("materials.default.E_MPa: 5500"), 29, "geometry.surface: {file: other.obj}");
+  const std::string dir = study_folder(text);
+  test::write_file(dir + "/other.obj", test::cubes_obj(1));
+  const Study study = load_study(dir + "/study.yaml");
+  ASSERT_EQ(study.variants.size(), 3u);
+  EXPECT_EQ(study.base, dir + "/base/cube.yaml");
+  EXPECT_EQ(study.variants[0].scenario.geometry.file, dir + "/base/cube.obj");
+  EXPECT_EQ(study.variants[1].scenario.geometry.file, dir + "/other.obj");
+  EXPECT_EQ(study.variants[0].scenario.supports[0].where.str(), dir +
+                                                                    "/base/cube.yaml:8:5: variant "
+                                                                    "'reference' of study " +
+                                                                    dir + "/study.yaml");
+  EXPECT_EQ(study.variants[2].scenario.supports[0].where.file, dir + "/base/cube.yaml");
+
+  // Degree 1 with the base's Poisson ratio of 0.49: refused at the base's line of poisson (untouched),
+  // naming the variant whose change made it wrong.
+  std::string base = kBase;
+  base.replace(base.find("poisson: 0.28}"), 14, "poisson: 0.49}\nsolver: {degree: 2}");
+  test::write_file(dir + "/base/cube.yaml", base);
+  text.replace(text.find("geometry.surface: {file: other.obj}"), 35, "solver.degree: 1");
+  test::write_file(dir + "/study.yaml", text);
+  const std::string error = test::message_of<InputError>([&] { load_study(dir + "/study.yaml"); });
+  EXPECT_NE(error.find(dir + "/base/cube.yaml:10:"), std::string::npos) << error;
+  EXPECT_NE(error.find("variant 'soft' of study " + dir + "/study.yaml: poisson 0.49 with solver.degree 1"),
+            std::string::npos)
+      << error;
+}
+
+// All or nothing: a variant whose displacements are absurd (a modulus in the wrong unit) fails the study
+// after the others solved, and the folder keeps the earlier study's files byte for byte.
+TEST(Study, AFailedVariantLeavesTheOutputFolderAsItWas) {
+  std::string first = kStudy;
+  first.erase(first.find("  - name: soft"));
+  const std::string dir = study_folder(first);
+  const std::string out = dir + "/out";
+  test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto before = test::files_under(out);
+  ASSERT_TRUE(before.count("reference/results.json"));
+  ASSERT_TRUE(before.count("study.json"));
+
+  test::write_file(dir + "/study.yaml", soft_setting("materials.default.E_MPa: 1.0e-6"));
+  r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("small displacements; the results of variant 'soft' are meaningless"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("the study kept none of its files and left '" + out + "' as it was"),
+            std::string::npos)
+      << r.err;
+  test::expect_same_files(before, test::files_under(out));
+
+  // Into a new folder: not created.
+  r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/new/out"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/new")) << r.err;
+}
+
+}  // namespace
+}  // namespace hexbite
