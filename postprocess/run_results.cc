@@ -40,6 +40,12 @@ class Checked {
   Key item(const Key& parent, std::size_t i) const {
     return {parent.value[i], parent.path + "[" + std::to_string(i) + "]"};
   }
+  // Calls f(item) for every item of the array `parent`.`name` (which must be there and be an array).
+  template <class F>
+  void each(const Key& parent, const std::string& name, F f) const {
+    const Key list = child(parent, name);
+    for (std::size_t i = 0; i < array(list).size(); ++i) f(item(list, i));
+  }
 
   const json& object(const Key& k) const {
     if (!k.value.is_object()) wrong(k, "an object");
@@ -146,39 +152,30 @@ void read_model(const Checked& c, const Key& top, RunFigures& r) {
     const Key materials = c.child(top, "materials");
     const Key d = c.child(materials, "default");
     r.default_material = MaterialFigures{"", c.number(d, "E_MPa"), c.number(d, "poisson"), std::nullopt};
-    const Key regions = c.child(materials, "regions");
-    for (std::size_t i = 0; i < c.array(regions).size(); ++i) {
-      const Key m = c.item(regions, i);
+    c.each(materials, "regions", [&](const Key& m) {
       r.material_regions.push_back(
           {c.text(c.child(m, "name")), c.number(m, "E_MPa"), c.number(m, "poisson"), c.whole(m, "hexes")});
-    }
+    });
   }
-  if (c.has(top, "muscles")) {
-    const Key muscles = c.child(top, "muscles");
-    for (std::size_t i = 0; i < c.array(muscles).size(); ++i) {
-      const Key m = c.item(muscles, i);
+  if (c.has(top, "muscles"))
+    c.each(top, "muscles", [&](const Key& m) {
       r.muscles.push_back({c.text(c.child(m, "name")), optional_number(m, "activation"), c.vec(m, "force_N"),
                            c.number(m, "magnitude_N"), c.number(m, "patch_area_mm2")});
-    }
-  }
-  if (c.has(top, "supports")) {
-    const Key supports = c.child(top, "supports");
-    for (std::size_t i = 0; i < c.array(supports).size(); ++i) {
-      const Key k = c.item(supports, i);
+    });
+  if (c.has(top, "supports"))
+    c.each(top, "supports", [&](const Key& k) {
       SupportFigures s;
       s.name = c.text(c.child(k, "name"));
       if (c.has(k, "center_mm")) s.center = c.vec(k, "center_mm");
       s.radius_mm = optional_number(k, "radius_mm");
       s.spring_N_per_mm3 = optional_number(k, "spring_N_per_mm3");
       if (c.has(k, "fixed")) {
-        const Key fixed = c.child(k, "fixed");
         s.fixed.emplace();
-        for (std::size_t j = 0; j < c.array(fixed).size(); ++j) s.fixed->push_back(c.text(c.item(fixed, j)));
+        c.each(k, "fixed", [&](const Key& axis) { s.fixed->push_back(c.text(axis)); });
       }
       s.patch_area_mm2 = c.number(k, "patch_area_mm2");
       r.supports.push_back(s);
-    }
-  }
+    });
 }
 
 // Line and column (1-based) of byte `byte` (1-based, as nlohmann's parse_error counts) of `text`.
@@ -251,10 +248,8 @@ RunFigures read_run_figures(const std::string& path) {
                                  figure("surface_volume_mm3"),
                                  figure("volume_difference")};
   }
-  if (c.has(top, "support_hold")) {
-    const Key hold = c.child(top, "support_hold");
-    for (std::size_t i = 0; i < c.array(hold).size(); ++i) {
-      const Key b = c.item(hold, i);
+  if (c.has(top, "support_hold"))
+    c.each(top, "support_hold", [&](const Key& b) {
       SupportHoldFigures s;
       s.weak = c.boolean(c.child(b, "weak"));
       s.hold = c.number(b, "hold");
@@ -262,8 +257,7 @@ RunFigures read_run_figures(const std::string& path) {
       s.direction = c.vec(b, "direction");
       if (s.rotation) s.axis_point = c.vec(b, "axis_point_mm");
       r.support_hold.push_back(s);
-    }
-  }
+    });
   if (c.has(top, "hexbite_version")) r.hexbite_version = c.text(c.child(top, "hexbite_version"));
   read_model(c, top, r);
   std::vector<std::string> support_order;
@@ -273,16 +267,14 @@ RunFigures read_run_figures(const std::string& path) {
   r.coarse.nodes = c.whole(mesh, "nodes");
   r.coarse.dofs = c.whole(mesh, "dofs");
   const Key validation = c.child(top, "validation");
-  const Key levels = c.child(validation, "levels");
-  for (std::size_t i = 0; i < c.array(levels).size(); ++i) {
-    const Key l = c.item(levels, i);
+  c.each(validation, "levels", [&](const Key& l) {
     LevelFigures f = level_figures(c, l, support_order);
     f.level = static_cast<int>(c.whole(l, "level"));
     f.hexes = c.whole(l, "hexes");
     f.nodes = c.whole(l, "nodes");
     f.dofs = c.whole(l, "dofs");
     r.levels.push_back(f);
-  }
+  });
   if (r.levels.empty())
     throw InputError("'" + path + "': key 'validation.levels' is empty; a run solves at least level 0");
   const Key change = c.child(validation, "relative_change");

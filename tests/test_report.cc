@@ -55,6 +55,14 @@ std::string run_cube(const std::string& scenario, const std::vector<std::string>
   return dir + "/run";
 }
 
+// kCube without its validation level and with everything from its supports on cut off, for a test to
+// append its own supports (and materials).
+std::string cube_without_levels_and_supports() {
+  std::string text = kCube;
+  text.replace(text.find("validation_levels: 1"), 20, "validation_levels: 0");
+  return text.substr(0, text.find("supports:"));
+}
+
 // The part of `html` from the heading that starts with `heading` to the next heading.
 std::string section(const std::string& html, const std::string& heading) {
   const std::size_t from = html.find("<h2>" + heading);
@@ -211,13 +219,10 @@ TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
 // bite patch on the top face fixed in z and a "condyle" patch on it fixed in x and y let the cube turn
 // about the axis along y through the bite. The report says so first.
 TEST(ReportWarnings, WeakSupportsAreWarnedAboutFirst) {
-  std::string text = kCube;
-  text.replace(text.find("validation_levels: 1"), 20, "validation_levels: 0");
-  text.replace(text.find("supports:"), std::string::npos,
-               "supports:\n"
-               "  - {name: nut, at: [18, 10, 20], radius_mm: 3, fixed: [z], bite: true}\n"
-               "  - {name: condyle, at: [2, 10, 20], radius_mm: 3, fixed: [x, y]}\n");
-  const std::string run = run_cube(text);
+  const std::string run = run_cube(cube_without_levels_and_supports() +
+                                   "supports:\n"
+                                   "  - {name: nut, at: [18, 10, 20], radius_mm: 3, fixed: [z], bite: true}\n"
+                                   "  - {name: condyle, at: [2, 10, 20], radius_mm: 3, fixed: [x, y]}\n");
   const json hold = json::parse(read_file(run + "/results.json"))["support_hold"][0];
   ASSERT_TRUE(hold["weak"].get<bool>()) << hold.dump();
   const std::string out = temp_dir() + "/weak.html";
@@ -236,9 +241,8 @@ TEST(ReportWarnings, WeakSupportsAreWarnedAboutFirst) {
 // What was simulated is in the report, from results.json alone: the materials with the hexes each takes, the
 // muscle loads, and each support's condition (fixed components or a spring), centre and radius.
 TEST(ReportModel, StatesTheMaterialsTheLoadsAndTheSupports) {
-  std::string text = kCube;
-  text.replace(text.find("validation_levels: 1"), 20, "validation_levels: 0");
-  text.replace(text.find("supports:"), std::string::npos,
+  const std::string run =
+      run_cube(cube_without_levels_and_supports() +
                "materials:\n"
                "  default: {E_MPa: 11000, poisson: 0.3}\n"
                "  regions:\n"
@@ -247,7 +251,6 @@ TEST(ReportModel, StatesTheMaterialsTheLoadsAndTheSupports) {
                "  - {name: nut, at: [0, 10, 10], radius_mm: 5, bite: true}\n"
                "  - {name: floor_rest, at: [10, 10, 0], radius_mm: 4, fixed: [y, z]}\n"
                "  - {name: pad, at: [10, 20, 10], radius_mm: 4.5, spring_N_per_mm3: 25}\n");
-  const std::string run = run_cube(text);
   const json r = json::parse(read_file(run + "/results.json"));
   const long graft = r["materials"]["regions"][0]["hexes"].get<long>();
   const long hexes = r["mesh"]["hexes"].get<long>();
