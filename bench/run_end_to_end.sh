@@ -51,6 +51,13 @@ echo "| mesh --method sheets --landmarks --refine-at right_first_molar_bite_poin
 # hexbite run on the default scenario (coarse mesh + 1 validation level), the main job's target: <= 60 s.
 scenario=scenarios/lateral_bite_hard_nut.yaml
 echo "| run, coarse + 1 validation level | $scenario | $(best_of "$hexbite" -q run "$scenario" -o "$work/run") |"
+# Its validation report, without and with its three pictures (these need an X display: xvfb-run gives one).
+echo "| report --no-pictures | the run above | $(best_of "$hexbite" -q report "$work/run" -o "$work/report.html" --no-pictures) |"
+display=()
+if [ -z "${DISPLAY:-}" ] && command -v xvfb-run >/dev/null; then display=(xvfb-run -a); fi
+echo "| report (3 pictures) | the run above | $(best_of "${display[@]}" "$hexbite" -q report "$work/run" -o "$work/report.html") |"
+# The shipped what-if study: four variants of the default scenario, each coarse + 1 validation level.
+echo "| study, 4 variants | scenarios/studies/atrophy_what_if.yaml | $(best_of "$hexbite" -q study scenarios/studies/atrophy_what_if.yaml -o "$work/study") |"
 
 # ccx_time DIR [SOLVER]: wall seconds of CalculiX on DIR/model.inp, with its default solver (SPOOLES) or
 # with *STATIC, SOLVER=ITERATIVE CHOLESKY, the two solvers Debian's CalculiX has.
