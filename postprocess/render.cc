@@ -234,6 +234,8 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
   bar->SetTitle(field.c_str());
   bar->SetNumberOfLabels(5);
   bar->SetMaximumWidthInPixels(110);
+  // VTK draws the title right on top of the bar, where it touched the top label ("von_mises" over "10.0").
+  bar->SetVerticalTitleSeparation(12);
   bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
   bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
   render_actor_png(actor, bar, png_path, options);
