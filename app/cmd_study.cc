@@ -121,7 +121,10 @@ void run_study(const StudyCliOptions& o) {
         const auto t = std::chrono::steady_clock::now();
         RunOutputs outputs(stage.stage_dir() + "/" + v.name);
         const std::vector<std::string> written = outputs.write(r, r.scenario.outputs.inp);
-        const nlohmann::ordered_json results = results_json(r, seconds_since(t));
+        nlohmann::ordered_json results = results_json(r, seconds_since(t));
+        // scenario_file names the base; this says which study and which changes made these results, so
+        // that the folder (and a report of it) is not taken for the base scenario's.
+        results["study"] = {{"name", study.name}, {"file", study.path}, {"variant", v.name}, {"set", v.set}};
         outputs.commit(results.dump(2) + '\n');
         for (const std::string& f : written) files.push_back(v.name + "/" + f);
         files.push_back(v.name + "/results.json");

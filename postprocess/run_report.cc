@@ -84,6 +84,12 @@ void what_was_run(std::ostringstream& out, const RunFigures& r, const ReportOpti
   out << "<h2>What was run</h2>\n";
   Table t(out);
   t.row({text("scenario"), text(html_escape(r.scenario) + " (file " + html_escape(r.scenario_file) + ")")});
+  if (r.study)
+    t.row({text("study"),
+           text("variant " + html_escape(r.study->variant) + " of study " + html_escape(r.study->name) +
+                " (file " + html_escape(r.study->file) + "): " +
+                (r.study->changes.empty() ? std::string("the scenario as it is")
+                                          : "the scenario with " + html_escape(r.study->changes)))});
   t.row({text("hexbite"), text(r.hexbite_version.empty()
                                    ? "report written by hexbite " + html_escape(o.hexbite_version) +
                                          "; this results.json does not record the version that ran"

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "postprocess/study_table.h"
 
 namespace hexbite {
 
@@ -229,6 +230,12 @@ RunFigures read_run_figures(const std::string& path) {
   r.scenario = c.text(c.child(top, "scenario"));
   r.scenario_file = c.text(c.child(top, "scenario_file"));
   r.mesh_method = c.text(c.child(top, "mesh_method"));
+  if (c.has(top, "study")) {
+    const Key s = c.child(top, "study");
+    c.object(c.child(s, "set"));
+    r.study = StudyFigures{c.text(c.child(s, "name")), c.text(c.child(s, "file")),
+                           c.text(c.child(s, "variant")), study_changes(c.child(s, "set").value, false)};
+  }
   const Key mesh = c.child(top, "mesh");
   if (c.has(mesh, "core")) r.mesh_core = c.text(c.child(mesh, "core"));
   r.degree = static_cast<int>(c.whole(mesh, "degree"));

@@ -94,9 +94,16 @@ struct SupportFigures {
   double patch_area_mm2 = 0;
 };
 
+// The study a run folder of `hexbite study` belongs to; results.json's `study`.
+struct StudyFigures {
+  std::string name, file, variant;
+  std::string changes;  // the variant's set entries, "path: value; path: value"; empty for the base as it is
+};
+
 struct RunFigures {
   std::string scenario, scenario_file, mesh_method, mesh_core;  // mesh_core empty for method sheets
   std::string hexbite_version;                                  // of the run; empty in older files
+  std::optional<StudyFigures> study;                            // none for `hexbite run`
   std::optional<MaterialFigures> default_material;              // none in older files
   std::vector<MaterialFigures> material_regions;
   std::vector<MuscleFigures> muscles;    // the active ones

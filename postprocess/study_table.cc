@@ -45,18 +45,6 @@ json reaction(const json& row, const std::string& support) {
   return row["reactions"].contains(support) ? row["reactions"][support] : json();
 }
 
-// A variant's changes on one line: "path: value; path: value". With `abbreviate` (Markdown), a mapping or
-// list longer than a table cell stands as "{...}" or "[...]": study.csv and study.json give it whole.
-std::string changes(const json& set, bool abbreviate) {
-  std::string out;
-  for (const auto& [path, value] : set.items()) {
-    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
-    if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
-    out += (out.empty() ? "" : "; ") + path + ": " + text;
-  }
-  return out;
-}
-
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
   std::string out = "\"";
@@ -90,6 +78,16 @@ std::string markdown_figure(const json& value, const json& change, int decimals)
 }
 
 }  // namespace
+
+std::string study_changes(const json& set, bool abbreviate) {
+  std::string out;
+  for (const auto& [path, value] : set.items()) {
+    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
+    out += (out.empty() ? "" : "; ") + path + ": " + text;
+  }
+  return out;
+}
 
 json study_json(const StudyTable& table) {
   json variants = json::array();
@@ -130,7 +128,7 @@ std::string study_csv(const json& study) {
   for (const Figure& f : kFigures) out << ',' << f.key << "_relative";
   out << '\n';
   for (const json& v : study["variants"]) {
-    out << csv_field(v["name"].get<std::string>()) << ',' << csv_field(changes(v["set"], false)) << ','
+    out << csv_field(v["name"].get<std::string>()) << ',' << csv_field(study_changes(v["set"], false)) << ','
         << v["level"].dump() << ',' << v["hexes"].dump();
     for (const Figure& f : kFigures) out << ',' << csv_number(v[f.key]);
     for (const std::string& s : supports) out << ',' << csv_number(reaction(v, s));
@@ -154,7 +152,7 @@ std::string study_markdown(const json& study) {
     const json& v = variants[i];
     const json& change = v["relative_to_reference"];
     const bool reference = i == 0;  // its changes against itself are zero: shown without them
-    const std::string set = changes(v["set"], true);
+    const std::string set = study_changes(v["set"], true);
     out << "| " << markdown_cell(v["name"].get<std::string>()) << " | "
         << (set.empty() ? "(none)" : "`" + markdown_cell(set) + "`") << " | " << v["level"].dump() << " | "
         << v["hexes"].dump() << " |";

@@ -35,6 +35,10 @@ struct StudyTable {
   std::vector<StudyRow> rows;  // the first is the reference
 };
 
+// A variant's changes on one line: "path: value; path: value". With `abbreviate` (Markdown), a mapping or
+// list longer than a table cell stands as "{...}" or "[...]": study.csv and study.json give it whole.
+std::string study_changes(const nlohmann::ordered_json& set, bool abbreviate);
+
 // {study, study_file, base, variants: [{name, set, level, hexes, bite_force_N, max_displacement_mm,
 // von_mises_max_MPa, von_mises_p99_MPa, strain_energy_mJ, reactions {support: N}, relative_to_reference
 // {the same figures and reactions as (variant - reference) / |reference|}}]}; a relative change is null

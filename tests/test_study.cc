@@ -164,16 +164,40 @@ TEST_F(CubeStudy, AVariantsFolderIsWhatHexbiteRunWrites) {
   const auto without_timings = [](const std::string& text) {
     json j = json::parse(text);
     j.erase("seconds");
+    j.erase("study");  // the study's own record (tested below); `hexbite run` has none
     j["solver"].erase("seconds");
     for (json& level : j["validation"]["levels"]) level["solver"].erase("seconds");
     return j;
   };
+  EXPECT_FALSE(json::parse(run_files["results.json"]).contains("study"));
   EXPECT_EQ(without_timings(study_files["results.json"]), without_timings(run_files["results.json"]));
   study_files.erase("results.json");
   run_files.erase("results.json");
   test::expect_same_files(run_files, study_files);
   EXPECT_EQ(json::parse(test::read_file(*dir_ + "/out/soft/results.json"))["max_displacement_mm"],
             variant("soft")["max_displacement_mm"]);
+}
+
+// scenario_file names the base scenario, so a variant's results.json says which study and which changes made
+// it, and a report of the variant's folder says so too.
+TEST_F(CubeStudy, AVariantsResultsAndReportNameTheStudyAndTheChanges) {
+  const json soft = json::parse(test::read_file(*dir_ + "/out/soft/results.json"));
+  EXPECT_EQ(soft["scenario_file"], *dir_ + "/base/cube.yaml");
+  EXPECT_EQ(soft["study"],
+            json::parse(R"({"name": "stiffness what-if", "file": ")" + *dir_ +
+                        R"(/study.yaml", "variant": "soft", "set": {"materials.default.E_MPa": 5500}})"));
+  for (const auto& [name, says] :
+       {std::pair<std::string, std::string>{"soft", "the scenario with materials.default.E_MPa: 5500"},
+        {"reference", "the scenario as it is"}}) {
+    const std::string html = *dir_ + "/" + name + ".html";
+    const test::CommandResult r =
+        test::run_hexbite({"-q", "report", *dir_ + "/out/" + name, "-o", html, "--no-pictures"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(test::read_file(html).find("variant " + name + " of study stiffness what-if (file " + *dir_ +
+                                         "/study.yaml): " + says),
+              std::string::npos)
+        << name;
+  }
 }
 
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
