@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -26,6 +27,8 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
+#include <type_traits>
 #include <unordered_map>
 
 #include "common/atomic_file.h"
@@ -381,10 +384,25 @@ class MshReader {
   }
   template <typename... T>
   void read(std::istringstream& s, T&... values) {
-    if (!((s >> values) && ...)) fail("expected more numbers on this line");
+    (read_one(s, values), ...);
   }
   [[noreturn]] void fail(const std::string& what) const {
     throw InputError("cannot read Gmsh mesh '" + path_ + "', line " + std::to_string(line_no_) + ": " + what);
+  }
+  // The next blank-separated token as a whole number or a finite number: a token such as "nan", "1.5" for a
+  // count or "1e999" is named, not taken for the end of the line.
+  template <typename V>
+  void read_one(std::istringstream& s, V& value) {
+    std::string token;
+    if (!(s >> token)) fail("expected more numbers on this line");
+    const char* first = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+    const char* last = token.data() + token.size();
+    const auto [end, error] = std::from_chars(first, last, value);
+    const std::string kind = std::is_integral_v<V> ? "a whole number" : "a number";
+    if (error == std::errc::result_out_of_range) fail("'" + token + "' is out of range for " + kind);
+    if (error != std::errc() || end != last) fail("'" + token + "' is not " + kind);
+    if constexpr (std::is_floating_point_v<V>)
+      if (!std::isfinite(value)) fail("'" + token + "' is not a finite number");
   }
   void expect_end(const std::string& section) {
     std::string line;

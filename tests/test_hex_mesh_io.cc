@@ -184,6 +184,32 @@ TEST(HexMeshIo, ReadersRejectMeshesWithoutHexesOrWithCollapsedHexes) {
   }
 }
 
+// A coordinate "nan" used to be reported as "expected more numbers on this line", as if the line were short.
+TEST(HexMeshIo, MshTokensThatAreNoNumbersAreNamed) {
+  const std::string dir = temp_dir();
+  const auto message = [&](const std::string& node_line) {
+    write_file(dir + "/bad.msh",
+               "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n1 0 0 0\n" + node_line + "\n$EndNodes\n");
+    return test::message_of<InputError>([&] { read_msh(dir + "/bad.msh"); });
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"2 1 nan 0", "line 7: 'nan' is not a finite number"},
+      {"2 1 -inf 0", "line 7: '-inf' is not a finite number"},
+      {"2 1 1e999 0", "line 7: '1e999' is out of range for a number"},
+      {"2.5 1 0 0", "line 7: '2.5' is not a whole number"},
+      {"2 1 0 0x", "line 7: '0x' is not a number"},
+      {"2 1 0", "line 7: expected more numbers on this line"}};
+  for (const auto& [line, expected] : cases) {
+    const std::string msg = message(line);
+    EXPECT_NE(msg.find("bad.msh', " + expected), std::string::npos) << line << ": " << msg;
+  }
+  write_file(dir + "/signed.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n+1 +1.5 -2e+1 "
+             "0\n$EndNodes\n$Elements\n0\n$EndElements\n");
+  EXPECT_NE(test::message_of<InputError>([&] { read_msh(dir + "/signed.msh"); }).find("holds no hexahedra"),
+            std::string::npos);  // signs and exponents as C's strtod takes them are numbers
+}
+
 // A string array with fewer values than points crashed VTK's reader (segmentation fault). No command uses
 // string arrays, so it is not read; the numeric array beside it is.
 TEST(HexMeshIo, ShortStringArrayIsSkippedNotACrash) {
