@@ -106,10 +106,22 @@ CLI::Validator output_hex_mesh_file() {
 CLI::Validator output_folder() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
+        const std::string give = "give a folder for the outputs (it is created if missing)";
+        if (value.empty()) return "the output folder is an empty name: " + give;
         std::error_code ec;
         if (fs::exists(value, ec) && !fs::is_directory(value, ec))
-          return "'" + value +
-                 "' is a file, not a folder: give a folder for the outputs (it is created if missing)";
+          return "'" + value + "' is a file, not a folder: " + give;
+        // A missing folder is created after the work; a file where a folder of its path should be would
+        // only be found then, so the path's deepest existing part is looked at now.
+        for (fs::path p = fs::path(value).parent_path(); !p.empty(); p = p.parent_path()) {
+          if (fs::exists(p, ec)) {
+            if (!fs::is_directory(p, ec))
+              return "cannot create the output folder '" + value + "': '" + p.string() +
+                     "' is a file, not a folder; " + give;
+            break;
+          }
+          if (p == p.parent_path()) break;
+        }
         return {};
       },
       "");

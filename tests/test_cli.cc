@@ -321,6 +321,9 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
       {{"generate", "mandible", "-o", dir + "/g.stl", "--ct", dir + "/g.raw"},
        "writes .mha, .mhd, .nii or .nii.gz"},
       {{"run", "scenario.yaml", "-o", cube}, "is a file, not a folder"},
+      // Both used to mesh and solve first and then fail with exit 1 ("Invalid argument", "Not a directory").
+      {{"run", "scenario.yaml", "-o", ""}, "the output folder is an empty name"},
+      {{"study", "study.yaml", "-o", cube + "/sub/out"}, "'" + cube + "' is a file, not a folder"},
   };
   for (const Case& c : cases) {
     const auto r = run_hexbite(c.args);
