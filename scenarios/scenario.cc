@@ -609,11 +609,20 @@ Outputs parse_outputs(const Value& v) {
 template <typename T>
 void check_unique_names(const std::vector<T>& items, const std::string& kind) {
   for (size_t i = 0; i < items.size(); ++i)
-    for (size_t j = 0; j < i; ++j)
-      if (items[i].name == items[j].name)
-        fail(items[i].where, kind + " " + quote(items[i].name) + " is defined twice (first on line " +
-                                 std::to_string(items[j].where.line) + "); give each " + kind +
-                                 " its own name");
+    for (size_t j = 0; j < i; ++j) {
+      if (items[i].name != items[j].name) continue;
+      // The list order is not the file's: the muscles of an activation_pattern come after the muscles
+      // list, wherever the pattern is written. The message names the later place and the earlier line.
+      const SourceLocation* first = &items[j].where;
+      const SourceLocation* second = &items[i].where;
+      if (first->file == second->file &&
+          std::tie(second->line, second->column) < std::tie(first->line, first->column))
+        std::swap(first, second);
+      fail(*second, kind + " " + quote(items[i].name) + " is defined twice (first on line " +
+                        std::to_string(first->line) +
+                        (first->file == second->file ? "" : " of " + first->file) + "); give each " + kind +
+                        " its own name");
+    }
 }
 
 // Linear (Q1) hexes lock as the material nears incompressibility: on the built-in mandible (4,025 hexes)

@@ -569,6 +569,11 @@ TEST(ScenarioErrors, DuplicateNames) {
                   "support 'right_condyle' is defined twice (first on line 9)");
   EXPECT_ERROR_AT(error_of(kValid + "activation_pattern:\n  superficial_masseter: 0.2\n"), 12,
                   "muscle 'right_superficial_masseter' is defined twice (first on line 5)");
+  // The pattern written above the list: the list's entry is the second one (it used to be named as the
+  // first, "first on line 7", at the pattern's line 5).
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "muscles:", "activation_pattern:\n  superficial_masseter: 0.2\nmuscles:")), 7,
+      "muscle 'right_superficial_masseter' is defined twice (first on line 5)");
   EXPECT_ERROR_AT(
       error_of(kValid + "probes:\n  - {name: p, at: incisal_point}\n  - {name: p, at: [0, 0, 0]}\n"), 13,
       "probe 'p' is defined twice");
