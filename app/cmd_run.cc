@@ -90,7 +90,14 @@ void add_run_command(CLI::App& app) {
       ->expected(1)
       ->allow_extra_args(false)  // one format per --export: `--export inp SCENARIO` is not two formats
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->check(CLI::IsMember({"inp"}));
+      ->check(CLI::Validator(
+          [](std::string& format) -> std::string {
+            return format == "inp"
+                       ? std::string()
+                       : "unknown format '" + format +
+                             "': the one format is inp (CalculiX); the VTU files are always written";
+          },
+          "inp"));
   cmd->add_option(
          "--levels", o->levels,
          "Validation levels (each refines the mesh 8-way and solves again); overrides the scenario's "

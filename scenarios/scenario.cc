@@ -78,7 +78,9 @@ double to_number(const Value& v) {
   if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<double>::decode(v.node, x) ||
       !std::isfinite(x))
     fail(v.at, v.path + " must be a number, found " + describe(v.node) +
-                   "; write a plain finite number such as 2.5");
+                   (is_quoted(v.node) && YAML::convert<double>::decode(v.node, x) && std::isfinite(x)
+                        ? "; write it as a plain number, without quotes: " + v.node.Scalar()
+                        : "; write a plain finite number such as 2.5"));
   return x;
 }
 

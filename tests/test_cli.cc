@@ -558,6 +558,7 @@ TEST(CliBadInput, RepeatedExportIsAcceptedAndAnUnknownFormatNamed) {
   r = run_hexbite({"run", missing, "-o", dir + "/out", "--export", "inp", "--export", "vtk"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--export"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("unknown format 'vtk': the one format is inp (CalculiX)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("inp"), std::string::npos) << r.err;
   // The scenario is not taken as a second format.
   r = run_hexbite({"run", "--export", "inp", missing, "-o", dir + "/out"});

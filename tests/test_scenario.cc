@@ -391,8 +391,11 @@ TEST(ScenarioErrors, MissingRequiredFields) {
 TEST(ScenarioErrors, IllTypedFields) {
   EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: high")), 6,
                   "muscles[0].activation must be a number, found 'high'");
-  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: \"0.5\"")), 6,
-                  "must be a number, found the quoted text \"0.5\"");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "activation: 0.5", "activation: \"0.5\"")), 6,
+      "must be a number, found the quoted text \"0.5\"; write it as a plain number, without quotes: 0.5");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: \"high\"")), 6,
+                  "; write a plain finite number such as 2.5");
   EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: !!str 0.5")), 6,
                   "must be a number, found the quoted text \"0.5\"");
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 2.5}\n"), 11,
