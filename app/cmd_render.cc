@@ -64,12 +64,15 @@ void add_render_command(CLI::App& app) {
                       "With --field: upper end of the colour scale (default: the field's maximum)")
           ->check(number_in_range(std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
                                   "greater than 0"));
-  cmd->add_option("--view", args->options.view, "iso, side (from the right), front, back or top");
+  cmd->add_option("--view", args->options.view, "iso, side (from the right), front, back or top")
+      ->capture_default_str();
   // Counts like the others (CLI::Range said "Value 1e3 not in range 64 to 8192", and the same of "abc").
   cmd->add_option("--width", args->options.width, "Picture width in pixels")
-      ->transform(count_in_range(64, 8192));
+      ->transform(count_in_range(64, 8192))
+      ->capture_default_str();
   cmd->add_option("--height", args->options.height, "Picture height in pixels")
-      ->transform(count_in_range(64, 8192));
+      ->transform(count_in_range(64, 8192))
+      ->capture_default_str();
   cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner");
   cmd->add_flag("!--no-edges", args->options.edges, "Do not draw the element edges");
   cmd->callback([args, units, field, max] {
