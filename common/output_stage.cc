@@ -1,10 +1,15 @@
 #include "common/output_stage.h"
 
+#include <fcntl.h>
 #include <stdlib.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
+#include <iostream>
 #include <set>
 
 #include "common/error.h"
@@ -19,6 +24,43 @@ namespace {
 std::string without_trailing_separator(std::string dir) {
   while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
   return dir;
+}
+
+constexpr char kStagePrefix[] = ".hexbite-stage-";
+
+// The stage's maker holds an flock on the stage folder for the stage's life, taken right after creating it;
+// a stage younger than this may not be locked yet.
+constexpr auto kLockGrace = std::chrono::seconds(10);
+
+// A run killed while it wrote (Ctrl-C, SIGKILL, a lost node) leaves its stage behind. A stage that nobody
+// holds locked and that is older than kLockGrace is abandoned and removed, unless it holds an earlier run's
+// files that an interrupted commit had set aside (.previous): those are the user's and are named instead.
+void remove_abandoned_stages(const fs::path& dir) {
+  std::error_code ec;
+  std::vector<fs::path> stages;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
+    std::error_code kind;
+    if (entry.path().filename().string().rfind(kStagePrefix, 0) == 0 && !entry.is_symlink(kind) &&
+        entry.is_directory(kind))
+      stages.push_back(entry.path());
+  }
+  for (const fs::path& stage : stages) {
+    const fs::file_time_type written = fs::last_write_time(stage, ec);
+    if (ec || fs::file_time_type::clock::now() - written < kLockGrace) continue;
+    const int fd = ::open(stage.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) continue;
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) {  // no live run holds it (a failed flock: leave it be)
+      const fs::path previous = stage / ".previous";
+      if (fs::is_directory(previous, ec) && !fs::is_empty(previous, ec))
+        std::cerr << "hexbite: warning: '" << previous.string()
+                  << "' holds files of an earlier run that an interrupted run had set aside; move them back "
+                     "into '"
+                  << dir.string() << "' or delete the folder.\n";
+      else
+        fs::remove_all(stage, ec);
+    }
+    ::close(fd);
+  }
 }
 
 }  // namespace
@@ -36,7 +78,8 @@ OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separat
     discard();
     throw RunError("cannot create the output folder '" + dir_ + "': " + ec.message());
   }
-  std::string name = (fs::path(dir_) / ".hexbite-stage-XXXXXX").string();
+  remove_abandoned_stages(dir_);
+  std::string name = (fs::path(dir_) / (std::string(kStagePrefix) + "XXXXXX")).string();
   if (::mkdtemp(name.data()) == nullptr) {
     const std::string reason = std::strerror(errno);
     discard();
@@ -44,6 +87,10 @@ OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separat
                    "; make it writable or choose another output folder");
   }
   stage_ = name;
+  // Marks the stage as in use for remove_abandoned_stages() of other runs into the same folder. Without the
+  // lock (a file system without flock) the stage is only never taken for abandoned.
+  lock_ = ::open(stage_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock_ >= 0) ::flock(lock_, LOCK_EX | LOCK_NB);
 }
 
 OutputStage::~OutputStage() {
@@ -54,7 +101,13 @@ void OutputStage::discard() noexcept {
   done_ = true;
   std::error_code ec;
   if (!stage_.empty()) fs::remove_all(stage_, ec);
+  unlock();
   for (const fs::path& p : created_) fs::remove(p, ec);  // only if empty: never what others put there
+}
+
+void OutputStage::unlock() noexcept {
+  if (lock_ >= 0) ::close(lock_);
+  lock_ = -1;
 }
 
 void OutputStage::commit(const std::vector<std::string>& files,
@@ -142,6 +195,7 @@ void OutputStage::commit(const std::vector<std::string>& files,
     }
     if (!stuck.empty()) {
       done_ = true;  // keep the stage
+      unlock();
       throw RunError(std::string(e.what()) + "; moving the earlier files back failed as well: " + stuck +
                      " are in " + stage_ + ", move them back by hand");
     }
@@ -152,6 +206,7 @@ void OutputStage::commit(const std::vector<std::string>& files,
   // The set is in place; what is left in the stage are the earlier run's replaced files.
   std::error_code ec;
   fs::remove_all(stage_, ec);
+  unlock();
 }
 
 std::string named_in_dir(std::string message, const std::string& stage_dir, const std::string& dir) {

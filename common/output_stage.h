@@ -9,8 +9,10 @@
 // commit() moves it into place; a failure of commit() puts everything back. Whatever fails, the output
 // folder ends as it was: the earlier files untouched and, if the folder did not exist, not created.
 //
-// A process killed in the middle (SIGKILL, a node lost) can leave the hidden folder (.hexbite-stage-*)
-// behind, but never a mixed set.
+// A process killed in the middle (Ctrl-C, SIGKILL, a node lost) can leave the hidden folder
+// (.hexbite-stage-*) behind; the next stage in the same folder removes it (each live stage holds an flock on
+// its folder, so a concurrent run's stage is never taken), unless it holds an earlier run's files that the
+// killed commit had set aside, which it names in a warning.
 #pragma once
 
 #include <filesystem>
@@ -51,10 +53,14 @@ class OutputStage {
   void discard() noexcept;
 
  private:
+  // Lets go of the stage's lock (closes its descriptor).
+  void unlock() noexcept;
+
   std::string dir_;
   std::string stage_;
   std::vector<std::filesystem::path> created_;  // folders the constructor created, deepest first
   bool done_ = false;                           // committed or discarded
+  int lock_ = -1;                               // descriptor of the stage folder holding its flock
 };
 
 // A writer's `message` names a file by its place in the stage `stage_dir`; this names it by its place in

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -114,6 +115,37 @@ TEST(OutputStage, AFileMissingFromTheStageIsRefusedAndNothingMoves) {
   EXPECT_NE(message.find("cannot write '" + dir + "/out_missing': it was not written"), std::string::npos)
       << message;
   test::expect_same_files(before, test::files_under(dir));
+}
+
+// A run killed while it wrote (Ctrl-C, SIGKILL) leaves its stage behind, and stages piled up. The next
+// stage in the folder removes it, but never a live run's stage (it holds the stage's lock), one just made
+// (perhaps not locked yet), nor an earlier run's files that an interrupted commit had set aside.
+TEST(OutputStage, AnAbandonedStageIsRemovedByTheNextOne) {
+  const std::string dir = test::temp_dir();
+  const auto hour_ago = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const char* stage : {"killed", "justmade", "midcommit/.previous"})
+    fs::create_directories(dir + "/.hexbite-stage-" + stage);
+  test::write_file(dir + "/.hexbite-stage-killed/out_a", "half\n");
+  fs::last_write_time(dir + "/.hexbite-stage-killed", hour_ago);
+  test::write_file(dir + "/.hexbite-stage-justmade/out_a", "half\n");
+  test::write_file(dir + "/.hexbite-stage-midcommit/.previous/out_a", "the earlier run's a\n");
+  fs::last_write_time(dir + "/.hexbite-stage-midcommit", hour_ago);
+  OutputStage live(dir);
+  test::write_file(live.stage_dir() + "/out_a", "live a\n");
+  fs::last_write_time(live.stage_dir(), hour_ago);
+
+  testing::internal::CaptureStderr();
+  { OutputStage next(dir); }
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(fs::exists(dir + "/.hexbite-stage-killed"));
+  EXPECT_TRUE(fs::exists(dir + "/.hexbite-stage-justmade/out_a"));
+  EXPECT_TRUE(fs::exists(dir + "/.hexbite-stage-midcommit/.previous/out_a"));
+  EXPECT_NE(err.find("hexbite: warning: '" + dir +
+                     "/.hexbite-stage-midcommit/.previous' holds files of an earlier run"),
+            std::string::npos)
+      << err;
+  live.commit({"out_a"}, is_output);
+  EXPECT_EQ(test::read_file(dir + "/out_a"), "live a\n");
 }
 
 // A folder that did not exist (nor its parent) is gone again when the set is given up.
