@@ -87,8 +87,8 @@ OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separat
                    "; make it writable or choose another output folder");
   }
   stage_ = name;
-  // Marks the stage as in use for remove_abandoned_stages() of other runs into the same folder. Without the
-  // lock (a file system without flock) the stage is only never taken for abandoned.
+  // Marks the stage as in use for remove_abandoned_stages() of other runs into the same folder. On a file
+  // system without flock their lock fails as well, and they leave the stage alone.
   lock_ = ::open(stage_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (lock_ >= 0) ::flock(lock_, LOCK_EX | LOCK_NB);
 }
