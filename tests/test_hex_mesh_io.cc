@@ -204,8 +204,9 @@ TEST(HexMeshIo, MshTokensThatAreNoNumbersAreNamed) {
     EXPECT_NE(msg.find("bad.msh', " + expected), std::string::npos) << line << ": " << msg;
   }
   write_file(dir + "/signed.msh",
-             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n+1 +1.5 -2e+1 "
-             "0\n$EndNodes\n$Elements\n0\n$EndElements\n");
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+             "$Nodes\n1\n+1 +1.5 -2e+1 0\n$EndNodes\n"
+             "$Elements\n0\n$EndElements\n");
   EXPECT_NE(test::message_of<InputError>([&] { read_msh(dir + "/signed.msh"); }).find("holds no hexahedra"),
             std::string::npos);  // signs and exponents as C's strtod takes them are numbers
 }
