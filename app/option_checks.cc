@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
+
+#include <unistd.h>
 
 namespace hexbite {
 namespace {
@@ -111,17 +116,26 @@ CLI::Validator output_folder() {
         std::error_code ec;
         if (fs::exists(value, ec) && !fs::is_directory(value, ec))
           return "'" + value + "' is a file, not a folder: " + give;
-        // A missing folder is created after the work; a file where a folder of its path should be would
-        // only be found then, so the path's deepest existing part is looked at now.
-        for (fs::path p = fs::path(value).parent_path(); !p.empty(); p = p.parent_path()) {
-          if (fs::exists(p, ec)) {
-            if (!fs::is_directory(p, ec))
-              return "cannot create the output folder '" + value + "': '" + p.string() +
-                     "' is a file, not a folder; " + give;
+        // A missing folder is created after the work; a file where a folder of its path should be, or a
+        // folder that takes no new entries (a read-only file system, /proc), would only be found then, so
+        // the path's deepest existing part is looked at now.
+        fs::path existing = value;
+        while (!fs::exists(existing, ec)) {
+          existing = existing.parent_path();
+          if (existing.empty()) {
+            existing = ".";
             break;
           }
-          if (p == p.parent_path()) break;
         }
+        if (!fs::is_directory(existing, ec))
+          return "cannot create the output folder '" + value + "': '" + existing.string() +
+                 "' is a file, not a folder; " + give;
+        // The run's stage is a folder made there, so making (and at once removing) one is the test.
+        std::string probe = (existing / ".hexbite-probe-XXXXXX").string();
+        if (::mkdtemp(probe.data()) == nullptr)
+          return "cannot create the output folder '" + value + "': no folder can be made in '" +
+                 existing.string() + "' (" + std::strerror(errno) + "); give a folder you can write to";
+        ::rmdir(probe.c_str());
         return {};
       },
       "");

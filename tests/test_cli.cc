@@ -324,6 +324,11 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
       // Both used to mesh and solve first and then fail with exit 1 ("Invalid argument", "Not a directory").
       {{"run", "scenario.yaml", "-o", ""}, "the output folder is an empty name"},
       {{"study", "study.yaml", "-o", cube + "/sub/out"}, "'" + cube + "' is a file, not a folder"},
+      // /proc takes no new folders, also for root (as a read-only file system): both used to mesh and
+      // solve first and then fail with exit 1.
+      {{"run", "scenario.yaml", "-o", "/proc/hexbite-out"},
+       "cannot create the output folder '/proc/hexbite-out': no folder can be made in '/proc'"},
+      {{"study", "study.yaml", "-o", "/proc/hexbite-out/study"}, "give a folder you can write to"},
   };
   for (const Case& c : cases) {
     const auto r = run_hexbite(c.args);
