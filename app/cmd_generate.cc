@@ -8,6 +8,7 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -17,6 +18,7 @@
 #include "common/output_stage.h"
 #include "common/progress.h"
 #include "mesher/ct_surface.h"
+#include "mesher/dicom_series.h"
 #include "mesher/landmarks.h"
 #include "mesher/mandible_generator.h"
 #include "mesher/surface_io.h"
@@ -28,7 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct GenerateArgs {
-  std::string output, landmarks, ct, variant = "dentate";
+  std::string output, landmarks, ct, dicom, variant = "dentate";
   MandibleParameters parameters;
 };
 
@@ -60,22 +62,18 @@ class GenerateOutputs {
   // Calls write(path in the stage of `path`'s folder); an error names the file by `path`.
   void write(const std::string& path, const std::function<void(const std::string&)>& write) {
     const fs::path target(path);
-    const std::string dir = target.has_parent_path() ? target.parent_path().string() : ".";
-    auto it = std::find_if(stages_.begin(), stages_.end(),
-                           [&](const std::unique_ptr<OutputStage>& s) { return s->dir() == dir; });
-    if (it == stages_.end()) {
-      stages_.push_back(std::make_unique<OutputStage>(dir));  // throws naming `dir`
-      it = std::prev(stages_.end());
-    }
-    const OutputStage& stage = **it;
-    const std::string kept = "; none of the outputs was written (files of those names are as they were)";
-    try {
-      write(stage.stage_dir() + "/" + target.filename().string());
-    } catch (const InputError& e) {
-      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
-    } catch (const std::exception& e) {
-      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
-    }
+    const OutputStage& stage = stage_for(target.has_parent_path() ? target.parent_path().string() : ".");
+    guarded(stage, [&] { write(stage.stage_dir() + "/" + target.filename().string()); });
+  }
+
+  // Calls write(the stage of the folder `dir`) for a set of files of its own (a DICOM series); at the
+  // commit, the files of the folder for which `retire(name)` is true and that this run did not write (a
+  // longer series of an earlier run) are removed.
+  void write_folder(const std::string& dir, const std::function<void(const std::string&)>& write,
+                    const std::function<bool(const std::string&)>& retire) {
+    const OutputStage& stage = stage_for(dir);
+    retire_[&stage] = retire;
+    guarded(stage, [&] { write(stage.stage_dir()); });
   }
 
   // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself).
@@ -85,13 +83,41 @@ class GenerateOutputs {
       for (const fs::directory_entry& entry : fs::directory_iterator(stage->stage_dir()))
         if (entry.is_regular_file()) files.push_back(entry.path().filename().string());
       std::sort(files.begin(), files.end());
-      stage->commit(files);
+      const auto retire = retire_.find(stage.get());
+      stage->commit(files, retire == retire_.end() ? nullptr : retire->second);
     }
   }
 
  private:
+  OutputStage& stage_for(const std::string& dir) {
+    auto it = std::find_if(stages_.begin(), stages_.end(),
+                           [&](const std::unique_ptr<OutputStage>& s) { return s->dir() == dir; });
+    if (it != stages_.end()) return **it;
+    stages_.push_back(std::make_unique<OutputStage>(dir));  // throws naming `dir`
+    return *stages_.back();
+  }
+
+  // Runs `write`; its error names the file by its place in the output folder, and says nothing was written.
+  static void guarded(const OutputStage& stage, const std::function<void()>& write) {
+    const std::string kept = "; none of the outputs was written (files of those names are as they were)";
+    try {
+      write();
+    } catch (const InputError& e) {
+      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+    } catch (const std::exception& e) {
+      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+    }
+  }
+
   std::vector<std::unique_ptr<OutputStage>> stages_;  // one per output folder; uncommitted ones discarded
+  std::map<const OutputStage*, std::function<bool(const std::string&)>> retire_;
 };
+
+// The slice files of a series that write_dicom_series wrote: ct_0001.dcm, ct_0002.dcm, ...
+bool is_series_slice(const std::string& name) {
+  return name.size() == 11 && name.compare(0, 3, "ct_") == 0 && name.compare(7, 4, ".dcm") == 0 &&
+         std::all_of(name.begin() + 3, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
+}
 
 void run_generate(const GenerateArgs& args) {
   MandibleParameters params = args.parameters;
@@ -114,6 +140,9 @@ void run_generate(const GenerateArgs& args) {
     write_landmarks(p, jaw.landmarks, mandible_landmark_header(params));
   });
   if (!args.ct.empty()) outputs.write(args.ct, [&](const std::string& p) { write_volume(p, jaw.ct); });
+  if (!args.dicom.empty())
+    outputs.write_folder(
+        args.dicom, [&](const std::string& dir) { write_dicom_series(dir, jaw.ct); }, is_series_slice);
   outputs.commit();
 
   Vec3 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -144,7 +173,10 @@ void run_generate(const GenerateArgs& args) {
   std::snprintf(buf, sizeof buf, "  CT grid %d x %d x %d voxels of %g mm, threshold %g HU; %.2f s",
                 jaw.ct.dims[0], jaw.ct.dims[1], jaw.ct.dims[2], jaw.ct.spacing, jaw.threshold, seconds);
   info(buf);
-  info("wrote " + args.output + ", " + landmark_path + (args.ct.empty() ? "" : ", " + args.ct));
+  info("wrote " + args.output + ", " + landmark_path + (args.ct.empty() ? "" : ", " + args.ct) +
+       (args.dicom.empty() ? ""
+                           : ", " + args.dicom + "/ (a DICOM series of " + std::to_string(jaw.ct.dims[2]) +
+                                 " slices, ct_0001.dcm ...)"));
 }
 
 // "Body height at the first molar in mm, 8 to 40 (default: dentate 27, edentulous 21, atrophic 12)": the
@@ -191,6 +223,11 @@ void add_generate_commands(CLI::App& app) {
       ->check(output_file({".yaml", ".yml"}));
   cmd->add_option("--ct", args->ct, "Also write the CT-like volume (.mha, .mhd, .nii, .nii.gz)")
       ->check(output_file({".mha", ".mhd", ".nii", ".nii.gz"}));
+  cmd->add_option(
+         "--dicom", args->dicom,
+         "Also write the CT-like volume as a DICOM series into this folder (created if missing): one "
+         "file per axial slice, ct_0001.dcm, ct_0002.dcm, ...; surface from-ct reads the folder")
+      ->check(output_folder());
   cmd->add_option("--variant", args->variant, "dentate, edentulous or atrophic (resorbed, low body)");
   // One option per row of the generator's table of dimensions, its range and the variants' defaults
   // printed from that table, so that the help cannot drift from what the generator accepts.

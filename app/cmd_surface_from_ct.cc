@@ -78,10 +78,12 @@ void run_from_ct(const FromCtArgs& args) {
 }  // namespace
 
 void add_surface_from_ct_command(CLI::App& surface) {
-  CLI::App* cmd = surface.add_subcommand(
-      "from-ct", "Extract the bone surface from a CT volume (MetaImage .mha/.mhd or NIfTI .nii/.nii.gz)");
+  CLI::App* cmd = surface.add_subcommand("from-ct",
+                                         "Extract the bone surface from a CT volume (MetaImage .mha/.mhd, "
+                                         "NIfTI .nii/.nii.gz, or a folder holding a DICOM series)");
   auto args = std::make_shared<FromCtArgs>();
-  cmd->add_option("VOLUME", args->volume, "CT volume file")->required();
+  cmd->add_option("VOLUME", args->volume, "CT volume file, or a folder of DICOM slices (one series)")
+      ->required();
   cmd->add_option("--threshold", args->threshold,
                   "Iso-value in the volume's units (e.g. Hounsfield units; the built-in mandible uses 620)")
       ->required()

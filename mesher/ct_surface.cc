@@ -33,6 +33,7 @@
 
 #include "common/error.h"
 #include "common/paths.h"
+#include "mesher/dicom_series.h"
 #include "mesher/vtk_messages.h"
 
 namespace hexbite {
@@ -221,12 +222,64 @@ vtkSmartPointer<vtkMatrix4x4> metaimage_orientation(const std::string& path) {
   return matrix;
 }
 
+// Turns an axis-aligned placement `m` (possibly with reversed axes) of the voxels' index grid, from the
+// index origin `org`, into a plain origin, flipping the reversed axes; a rotated grid would need
+// resampling, which is the job of a dedicated imaging tool. `what` names the input in messages.
+void place_axis_aligned(VoxelVolume& v, const vtkMatrix4x4& m, const double org[3], const std::string& what) {
+  // Off-diagonal terms first: a rotation by 90 degrees has zeros on the diagonal and must be called a
+  // rotation, not a scaling.
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (r != c && std::abs(m.GetElement(r, c)) > 1e-6)
+        throw InputError(what +
+                         " is stored in a rotated orientation; resample it to an axis-aligned grid first");
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(std::abs(m.GetElement(a, a)) - 1) > 1e-6)
+      throw InputError(what + " has a scaled orientation matrix; it is not supported");
+  for (int a = 0; a < 3; ++a) {
+    const double t = m.GetElement(a, 3) + m.GetElement(a, a) * org[a];
+    if (m.GetElement(a, a) < 0) {
+      flip_axis(v, a);
+      v.origin[a] = t - (v.dims[a] - 1) * v.axis_spacing[a];
+    } else {
+      v.origin[a] = t;
+    }
+  }
+}
+
+// A grid of cubes keeps its one spacing (VoxelVolume::spacing) and no per-axis spacing.
+void drop_equal_axis_spacing(VoxelVolume& v) {
+  v.spacing = v.axis_spacing[0];
+  if (std::abs(v.axis_spacing[1] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0] &&
+      std::abs(v.axis_spacing[2] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0])
+    v.axis_spacing = {};
+}
+
+// A DICOM series (mesher/dicom_series.h) as a volume: its slices' placement, in patient coordinates (LPS,
+// hexbite's frame), through the same axis-aligned placement as the files' orientation matrices.
+VoxelVolume volume_from_dicom(const std::string& folder) {
+  DicomSeries series = read_dicom_series(folder);
+  VoxelVolume v;
+  v.dims = series.dims;
+  v.values = std::move(series.values);
+  v.axis_spacing = {series.spacing[0], series.spacing[1], series.spacing[2]};
+  auto m = vtkSmartPointer<vtkMatrix4x4>::New();
+  for (int r = 0; r < 3; ++r) {
+    for (int a = 0; a < 3; ++a) m->SetElement(r, a, series.axes[a][r]);
+    m->SetElement(r, 3, series.first[r]);
+  }
+  const double org[3] = {0, 0, 0};
+  place_axis_aligned(v, *m, org, "DICOM series '" + folder + "'");
+  drop_equal_axis_spacing(v);
+  return v;
+}
+
 }  // namespace
 
 VoxelVolume read_volume(const std::string& path) {
   if (!fs::exists(path)) throw InputError("volume file '" + path + "' does not exist");
+  if (fs::is_directory(path)) return volume_from_dicom(path);
   const FormatAndExtension fmt = volume_format(path);
-  if (fs::is_directory(path)) throw InputError("'" + path + "' is a folder, not a volume file");
 
   ErrorCatcher errors;
   const VtkMessageCapture muted;  // VTK's logger prints a failed pipeline request in colour by itself
@@ -314,39 +367,14 @@ VoxelVolume read_volume(const std::string& path) {
     v.values[static_cast<std::size_t>(i)] = static_cast<float>(value);
   }
 
-  if (orientation) {
-    // Axis-aligned placements (possibly with reversed axes) are turned into a plain origin;
-    // a rotated grid would need resampling, which is the job of a dedicated imaging tool.
-    // Off-diagonal terms first: a rotation by 90 degrees has zeros on the diagonal and must be
-    // called a rotation, not a scaling.
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        if (r != c && std::abs(orientation->GetElement(r, c)) > 1e-6)
-          throw InputError("volume '" + path +
-                           "' is stored in a rotated orientation; resample it to an axis-aligned grid first");
-    for (int a = 0; a < 3; ++a)
-      if (std::abs(std::abs(orientation->GetElement(a, a)) - 1) > 1e-6)
-        throw InputError("volume '" + path + "' has a scaled orientation matrix; it is not supported");
-    for (int a = 0; a < 3; ++a) {
-      const double t = orientation->GetElement(a, 3) + orientation->GetElement(a, a) * org[a];
-      if (orientation->GetElement(a, a) < 0) {
-        flip_axis(v, a);
-        v.origin[a] = t - (v.dims[a] - 1) * v.axis_spacing[a];
-      } else {
-        v.origin[a] = t;
-      }
-    }
-  }
+  if (orientation) place_axis_aligned(v, *orientation, org, "volume '" + path + "'");
   if (length_scale != 1) {
     for (int a = 0; a < 3; ++a) {
       v.origin[a] *= length_scale;
       v.axis_spacing[a] *= length_scale;
     }
-    v.spacing = v.axis_spacing[0];
   }
-  if (std::abs(v.axis_spacing[1] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0] &&
-      std::abs(v.axis_spacing[2] - v.axis_spacing[0]) <= 1e-9 * v.axis_spacing[0])
-    v.axis_spacing = {};
+  drop_equal_axis_spacing(v);
   return v;
 }
 

@@ -9,7 +9,8 @@
 
 namespace hexbite {
 
-// Reads MetaImage (.mha/.mhd) or NIfTI (.nii/.nii.gz); throws InputError naming the file otherwise.
+// Reads MetaImage (.mha/.mhd), NIfTI (.nii/.nii.gz) or, given a folder, the DICOM series in it
+// (mesher/dicom_series.h); throws InputError naming the file or folder otherwise.
 VoxelVolume read_volume(const std::string& path);
 
 // What the extraction left out: the iso-surface's other connected pieces, told apart by the sign

@@ -171,7 +171,9 @@ double patch_radius(const Value& v, const std::string& unit_hint) {
   return r;
 }
 
-std::string resolve_file(const Source& ctx, const Value& v, const std::string& kind) {
+// With `folder_too`, a folder is taken as well (a CT volume given as a DICOM series).
+std::string resolve_file(const Source& ctx, const Value& v, const std::string& kind,
+                         bool folder_too = false) {
   const std::string given = to_string(v);
   fs::path path(given);
   // A path that a study set resolves against the study file's folder (yaml_input.h).
@@ -179,11 +181,12 @@ std::string resolve_file(const Source& ctx, const Value& v, const std::string& k
   if (path.is_relative()) path = folder / path;
   path = path.lexically_normal();
   std::error_code error;
-  if (!fs::is_regular_file(path, error))
+  if (!fs::is_regular_file(path, error) && !(folder_too && fs::is_directory(path, error)))
     fail(v.at, kind + " file " + quote(given) +
                    (path.string() == given ? std::string() : " (resolved to " + quote(path.string()) + ")") +
-                   " does not exist or is not a file; give a path relative to the " +
-                   (folder == ctx.folder ? "scenario" : "study") + " file's folder or an absolute path");
+                   " does not exist or is not a file" + (folder_too ? " or folder" : "") +
+                   "; give a path relative to the " + (folder == ctx.folder ? "scenario" : "study") +
+                   " file's folder or an absolute path");
   return path.string();
 }
 
@@ -242,7 +245,7 @@ GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
   } else {
     g.source = GeometrySource::kCt;
     const Map c(map.get("ct"), {"file", "threshold"});
-    g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume");
+    g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume", true);
     g.threshold =
         to_number(c.require("threshold", "threshold: 400 (the bone iso-value, e.g. in Hounsfield units)"));
   }

@@ -239,6 +239,15 @@ TEST(Scenario, RelativeFilesAreResolvedAgainstTheScenarioFolder) {
       error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: " + absolute + "}"));
   EXPECT_NE(message.find("surface file '" + absolute + "' does not exist"), std::string::npos) << message;
   EXPECT_EQ(message.find("resolved to"), std::string::npos) << message;
+
+  // A CT volume may be a folder (a DICOM series); a surface may not.
+  fs::create_directories(dir + "/data/ct_series");
+  test::write_file(dir + "/ct.yaml", replace(kValid, "mandible: {variant: dentate}",
+                                             "ct: {file: data/ct_series, threshold: 400}"));
+  EXPECT_EQ(load_scenario(dir + "/ct.yaml").geometry.file, (fs::path(dir) / "data/ct_series").string());
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: " + dir + "/data}")), 3,
+      "does not exist or is not a file; give a path");
 }
 
 TEST(Scenario, ActivationPatternExpandsToBothSides) {

@@ -1,0 +1,217 @@
+// CT volumes as DICOM series (mesher/dicom_series.h): written, read back, cross-checked with VTK's own
+// DICOM reader, and every folder a scanner export can get wrong refused with the file named.
+#include <gtest/gtest.h>
+#include <vtkDICOMImageReader.h>
+#include <vtkImageData.h>
+#include <vtkSmartPointer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/error.h"
+#include "mesher/ct_surface.h"
+#include "mesher/dicom_series.h"
+#include "mesher/surface_io.h"
+#include "tests/test_util.h"
+
+namespace hexbite {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small anisotropic volume whose values the series stores exactly with slope 0.5 and intercept -1024: a
+// mirrored, shifted or transposed read changes them.
+VoxelVolume test_volume(int nx = 12, int ny = 9, int nz = 7) {
+  VoxelVolume v;
+  v.dims = {nx, ny, nz};
+  v.origin = {-10.0, 5.5, 30.0};
+  v.axis_spacing = {0.5, 0.75, 1.25};
+  v.spacing = 0.5;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) v.values.push_back(float(-1024.0 + 0.5 * (i + 37 * j + 401 * k)));
+  return v;
+}
+
+DicomWriteOptions rescaled() {
+  DicomWriteOptions o;
+  o.slope = 0.5;
+  o.intercept = -1024;
+  return o;
+}
+
+std::string written_series(const VoxelVolume& v = test_volume()) {
+  const std::string dir = test::temp_dir() + "/series";
+  fs::create_directories(dir);
+  write_dicom_series(dir, v, rescaled());
+  return dir;
+}
+
+void expect_same_volume(const VoxelVolume& back, const VoxelVolume& v) {
+  EXPECT_EQ(back.dims, v.dims);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(back.origin[a], v.origin[a], 1e-6) << a;
+    EXPECT_NEAR(back.spacing_xyz()[a], v.spacing_xyz()[a], 1e-6) << a;
+  }
+  EXPECT_TRUE(back.values == v.values);
+}
+
+std::string error_of(const std::string& folder) {
+  try {
+    read_volume(folder);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(DicomSeries, AVolumeWrittenAsASeriesReadsBackExactly) {
+  const VoxelVolume v = test_volume();
+  const std::string dir = test::temp_dir() + "/series";
+  fs::create_directories(dir);
+  const std::vector<std::string> names = write_dicom_series(dir, v, rescaled());
+  ASSERT_EQ(names.size(), 7u);
+  EXPECT_EQ(names.front(), "ct_0001.dcm");
+  expect_same_volume(read_volume(dir), v);
+  const DicomSeries s = read_dicom_series(dir);
+  EXPECT_EQ(s.modality, "CT");
+  EXPECT_EQ(s.series_uid.rfind("2.25.", 0), 0u) << s.series_uid;
+  // The same volume gives the same bytes (the UIDs come from the content, no time of writing).
+  const std::string again = test::temp_dir() + "/again";
+  fs::create_directories(again);
+  write_dicom_series(again, v, rescaled());
+  for (const std::string& name : names)
+    EXPECT_EQ(test::read_file(dir + "/" + name), test::read_file(again + "/" + name)) << name;
+}
+
+// VTK's DICOM reader, an independent parser, sees the same grid. It hands over the Pixel Spacing tag's two
+// values in the file's order, which DICOM defines as the row spacing (between rows: along j, 0.75 mm) and
+// then the column spacing (along i, 0.5 mm): a writer and a reader of ours that both swapped them would
+// agree with each other, and a surgeon's scan with non-square pixels would come out stretched.
+TEST(DicomSeries, VtksOwnDicomReaderSeesTheSameGrid) {
+  const std::string dir = written_series();
+  auto reader = vtkSmartPointer<vtkDICOMImageReader>::New();
+  reader->SetDirectoryName(dir.c_str());
+  reader->Update();
+  int dims[3];
+  reader->GetOutput()->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 12);
+  EXPECT_EQ(dims[1], 9);
+  EXPECT_EQ(dims[2], 7);
+  const double* spacing = reader->GetPixelSpacing();
+  EXPECT_NEAR(spacing[0], 0.75, 1e-6);  // the tag's first value: the row spacing
+  EXPECT_NEAR(spacing[1], 0.5, 1e-6);
+  EXPECT_NEAR(reader->GetRescaleSlope(), 0.5, 1e-9);
+  EXPECT_NEAR(reader->GetRescaleOffset(), -1024, 1e-9);
+}
+
+// Scanners name their files anyhow (by UID, by acquisition time): the order comes from the slices'
+// positions, and files that are no DICOM image (a README, a DICOMDIR) are left out and counted.
+TEST(DicomSeries, FileNamesDoNotOrderTheSlicesAndOtherFilesAreLeftOut) {
+  const VoxelVolume v = test_volume();
+  const std::string dir = written_series(v);
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  // Reverse the names: ct_0001.dcm now holds the last slice.
+  for (std::size_t i = 0; i < names.size(); ++i) fs::rename(dir + "/" + names[i], dir + "/x" + names[i]);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    fs::rename(dir + "/x" + names[i], dir + "/" + names[names.size() - 1 - i]);
+  test::write_file(dir + "/README.txt", "exported by the scanner\n");
+  expect_same_volume(read_volume(dir), v);
+  EXPECT_EQ(read_dicom_series(dir).other_files, 1);
+}
+
+TEST(DicomSeries, AFolderWithoutASeriesIsRefused) {
+  const std::string dir = test::temp_dir() + "/empty";
+  fs::create_directories(dir);
+  test::write_file(dir + "/notes.txt", "no images here\n");
+  EXPECT_NE(error_of(dir).find("'" + dir + "' holds no DICOM image (1 files read)"), std::string::npos)
+      << error_of(dir);
+}
+
+TEST(DicomSeries, AMissingSliceIsNamedByTheFilesAroundTheGap) {
+  const std::string dir = written_series();
+  fs::remove(dir + "/ct_0004.dcm");
+  const std::string e = error_of(dir);
+  EXPECT_NE(
+      e.find("files 'ct_0003.dcm' and 'ct_0005.dcm' lie 2.5 mm apart where the other slices are 1.25 mm "
+             "apart (1 slice missing?)"),
+      std::string::npos)
+      << e;
+}
+
+TEST(DicomSeries, ADuplicateSliceIsNamed) {
+  const std::string dir = written_series();
+  fs::copy_file(dir + "/ct_0003.dcm", dir + "/copy.dcm");
+  const std::string e = error_of(dir);
+  EXPECT_NE(e.find("lie at the same place"), std::string::npos) << e;
+  EXPECT_NE(e.find("'copy.dcm'"), std::string::npos) << e;
+}
+
+// Two series in one folder (a scout and the bone kernel, say): refused with both named, not mixed.
+TEST(DicomSeries, TwoSeriesInOneFolderAreNamedNotMixed) {
+  const std::string dir = written_series();
+  const std::string other = test::temp_dir() + "/other";
+  fs::create_directories(other);
+  VoxelVolume second = test_volume();
+  second.values[0] += 1;  // other content, so other UIDs
+  write_dicom_series(other, second, rescaled());
+  for (const auto& e : fs::directory_iterator(other))
+    fs::copy_file(e.path(), dir + "/b_" + e.path().filename().string());
+  const std::string e = error_of(dir);
+  EXPECT_NE(e.find("holds 2 DICOM series: '2.25."), std::string::npos) << e;
+  EXPECT_NE(e.find("(hexbite CT-like volume, 7 slices)"), std::string::npos) << e;
+  EXPECT_NE(e.find("copy the files of the one to use into a folder of their own"), std::string::npos) << e;
+}
+
+TEST(DicomSeries, ASingleSliceIsNoVolume) {
+  const std::string dir = test::temp_dir() + "/one";
+  fs::create_directories(dir);
+  write_dicom_series(dir, test_volume(12, 9, 1), rescaled());
+  EXPECT_NE(error_of(dir).find("has one slice; a volume needs at least two"), std::string::npos)
+      << error_of(dir);
+}
+
+// The command line: `generate --dicom` writes a series that `surface from-ct` reads as it reads the
+// MetaImage of the same volume (the series rounds the values to whole Hounsfield units), and a second
+// generate into the folder leaves one series.
+TEST(DicomSeries, GenerateWritesASeriesThatSurfaceFromCtReads) {
+  const std::string dir = test::temp_dir();
+  const auto gen = test::run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--ct",
+                                      dir + "/jaw.mha", "--dicom", dir + "/jaw_ct"});
+  ASSERT_EQ(gen.exit_code, 0) << gen.err;
+  EXPECT_TRUE(fs::exists(dir + "/jaw_ct/ct_0001.dcm"));
+  for (const char* input : {"jaw.mha", "jaw_ct"}) {
+    const auto r = test::run_hexbite({"-q", "surface", "from-ct", dir + "/" + input, "--threshold", "620",
+                                      "-o", dir + "/" + input + ".stl"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const TriSurface from_mha = read_surface(dir + "/jaw.mha.stl");
+  const TriSurface from_dicom = read_surface(dir + "/jaw_ct.stl");
+  auto box = [](const TriSurface& s) {
+    std::array<double, 6> b{1e9, 1e9, 1e9, -1e9, -1e9, -1e9};
+    for (const Vec3& p : s.vertices)
+      for (int a = 0; a < 3; ++a) b[a] = std::min(b[a], p[a]), b[a + 3] = std::max(b[a + 3], p[a]);
+    return b;
+  };
+  const auto b0 = box(from_mha), b1 = box(from_dicom);
+  for (int a = 0; a < 6; ++a) EXPECT_NEAR(b1[a], b0[a], 0.01) << a;  // not mirrored, not shifted
+  EXPECT_NEAR(double(from_dicom.triangles.size()), double(from_mha.triangles.size()),
+              0.01 * double(from_mha.triangles.size()));
+
+  // A second, smaller volume (coarser voxels) into the same folder: its slices replace the first run's and
+  // the first run's surplus slices are removed, so the folder holds one series.
+  const auto coarse = test::run_hexbite(
+      {"-q", "generate", "mandible", "-o", dir + "/jaw2.stl", "--voxel", "1.5", "--dicom", dir + "/jaw_ct"});
+  ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
+  const DicomSeries s = read_dicom_series(dir + "/jaw_ct");
+  EXPECT_NEAR(s.spacing[2], 1.5, 1e-9);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/jaw_ct"), fs::directory_iterator{}), s.dims[2]);
+}
+
+}  // namespace
+}  // namespace hexbite
