@@ -279,6 +279,14 @@ VoxelVolume volume_from_dicom(const std::string& folder) {
 VoxelVolume read_volume(const std::string& path) {
   if (!fs::exists(path)) throw InputError("volume file '" + path + "' does not exist");
   if (fs::is_directory(path)) return volume_from_dicom(path);
+  // One file of a DICOM series (the preamble's "DICM" at byte 128), given instead of its folder.
+  char magic[4] = {};
+  std::ifstream(path, std::ios::binary).seekg(128).read(magic, 4);
+  if (std::string(magic, 4) == "DICM") {
+    const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+    throw InputError("'" + path + "' is one DICOM file (a slice of a series); give the folder that holds " +
+                     "the series: '" + folder.string() + "'");
+  }
   const FormatAndExtension fmt = volume_format(path);
 
   ErrorCatcher errors;

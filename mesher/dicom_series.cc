@@ -65,6 +65,11 @@ Vec3 cross3(const Vec3& a, const Vec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
+// "1 file", "3 files".
+std::string counted(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
 std::string mm(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g mm", x);
@@ -225,14 +230,14 @@ DicomSeries read_dicom_series(const std::string& folder) {
     s.slices.push_back(std::move(slice));
   }
   if (series.empty())
-    throw InputError("'" + folder + "' holds no DICOM image (" + std::to_string(files.size()) +
-                     " files read); give the folder of a CT series, one file per slice");
+    throw InputError("'" + folder + "' holds no DICOM image (" + counted(files.size(), "file") +
+                     " read); give the folder of a CT series, one file per slice");
   if (series.size() > 1) {
     std::string list;
     for (const auto& [uid, s] : series)
       list += std::string(list.empty() ? "" : "; ") + "'" + uid + "' (" +
-              (s.description.empty() ? s.modality : s.description) + ", " + std::to_string(s.slices.size()) +
-              " slices)";
+              (s.description.empty() ? s.modality : s.description) + ", " +
+              counted(s.slices.size(), "slice") + ")";
     throw InputError("'" + folder + "' holds " + std::to_string(series.size()) + " DICOM series: " + list +
                      "; copy the files of the one to use into a folder of their own");
   }
@@ -306,7 +311,10 @@ DicomSeries read_dicom_series(const std::string& folder) {
   out.modality = s.modality;
   out.description = s.description;
   out.values.reserve(std::size_t(out.dims[0]) * out.dims[1] * out.dims[2]);
-  for (const Slice& sl : slices) out.values.insert(out.values.end(), sl.values.begin(), sl.values.end());
+  for (Slice& sl : slices) {
+    out.values.insert(out.values.end(), sl.values.begin(), sl.values.end());
+    std::vector<float>().swap(sl.values);  // a 300-slice CT holds 300 MB of floats: not twice
+  }
   return out;
 }
 

@@ -129,8 +129,18 @@ TEST(DicomSeries, AFolderWithoutASeriesIsRefused) {
   const std::string dir = test::temp_dir() + "/empty";
   fs::create_directories(dir);
   test::write_file(dir + "/notes.txt", "no images here\n");
-  EXPECT_NE(error_of(dir).find("'" + dir + "' holds no DICOM image (1 files read)"), std::string::npos)
+  EXPECT_NE(error_of(dir).find("'" + dir + "' holds no DICOM image (1 file read)"), std::string::npos)
       << error_of(dir);
+}
+
+// A slice file given for its series (what a file dialog hands over) is told to give the folder.
+TEST(DicomSeries, OneSliceFileIsToldToGiveItsFolder) {
+  const std::string dir = written_series();
+  const std::string e = error_of(dir + "/ct_0002.dcm");
+  EXPECT_NE(
+      e.find("is one DICOM file (a slice of a series); give the folder that holds the series: '" + dir + "'"),
+      std::string::npos)
+      << e;
 }
 
 TEST(DicomSeries, AMissingSliceIsNamedByTheFilesAroundTheGap) {
