@@ -179,6 +179,13 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
       options.floor_scaled_jacobian > 0 ? std::min(sj_min, options.floor_scaled_jacobian) : sj_min;
   const double kappa_bound = std::max(kappa_max, options.max_condition);
   std::vector<char> ever_moved(mesh.vertices.size(), 0);
+  // A surface vertex within the limit whose closest boundary quad kept its nodes is no farther now (that
+  // quad's points are still there), so only the far vertices and those near moved nodes are measured again:
+  // the same far vertices as measuring all, at a fraction of the queries on a fine surface (a 0.25 mm CT's
+  // 394,000 vertices against a 4,000-hex boundary: this pass took half of the meshing time).
+  std::vector<int> last_moved(mesh.vertices.size(), -1);  // the round in which a node last moved
+  std::vector<double> known_distance(samples.size(), std::numeric_limits<double>::infinity());
+  std::vector<int> known_quad(samples.size(), -1), known_round(samples.size(), -1);
   for (int round = 0; round < options.rounds; ++round) {
     const HexBoundary boundary = extract_boundary(mesh);
     const QuadSurface& q = boundary.surface;
@@ -191,8 +198,18 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
     const SurfaceProjector boundary_surface(fan_triangles(q));
     std::vector<std::pair<double, int>> far;  // (distance, surface vertex), farthest first
     for (std::size_t v = 0; v < samples.size(); ++v) {
-      const double d = boundary_surface.distance(samples[v]);
-      if (d > limit) far.emplace_back(d, static_cast<int>(v));
+      if (known_quad[v] >= 0 && known_distance[v] <= limit) {
+        const auto& quad = q.quads[static_cast<std::size_t>(known_quad[v])];
+        if (std::none_of(quad.begin(), quad.end(), [&](int corner) {
+              return last_moved[boundary.boundary_vertices[corner]] >= known_round[v];
+            }))
+          continue;
+      }
+      const SurfacePoint closest = boundary_surface.closest(samples[v]);
+      known_distance[v] = closest.distance;
+      known_quad[v] = closest.triangle / 4;  // fan_triangles: four triangles per quad, in quad order
+      known_round[v] = round;
+      if (closest.distance > limit) far.emplace_back(closest.distance, static_cast<int>(v));
     }
     std::sort(far.rbegin(), far.rend());
     if (round == 0) report.far_vertices = static_cast<int>(far.size());
@@ -232,6 +249,7 @@ FarSurfaceReport reach_far_surface(HexMesh& mesh, const SurfaceProjector& surfac
         continue;
       }
       for (int e : hexes_of[node]) quality[e] = quality_of(mesh, e);
+      last_moved[node] = round;
       if (!ever_moved[node]) report.moved.push_back(node);
       ever_moved[node] = 1;
       ++moved;

@@ -68,8 +68,9 @@ BoundaryFitReport fit_boundary_to_volume(HexMesh& mesh, const SurfaceProjector& 
 // min(mesh's minimum, floor) and at most the larger of its own and max(mesh's maximum, cap); without it
 // (before the optimizer, which untangles and improves what the moves spoil) no hex falls below the smaller
 // of its own scaled Jacobian and min_scaled_jacobian.
-// Cost: per round one closest-point query per surface vertex against the boundary, and a scan of the boundary
-// nodes per far vertex, O(V log Q + F B) for V surface vertices, Q quads, F far vertices, B boundary nodes.
+// Cost: in the first round one closest-point query per surface vertex against the boundary, in later rounds
+// only for the far vertices and those whose closest quad has a moved node; and a scan of the boundary nodes
+// per far vertex: O(V log Q + F B) for V surface vertices, Q quads, F far vertices, B boundary nodes.
 struct FarSurfaceOptions {
   double limit = 0.5;  // surface vertices farther than this many mean boundary edges from the boundary pull
   int rounds = 5;      // rounds (stops early when no node moves)

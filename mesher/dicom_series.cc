@@ -168,22 +168,30 @@ bool read_slice(const std::string& file, const std::string& folder, Slice& slice
   return true;
 }
 
-// 128 bits of FNV-1a over `bytes`, seeded twice, as the decimal of a UID under the 2.25 root (ISO/IEC
-// 9834-8: a UID from a 128-bit number); deterministic, unlike GDCM's generator.
-std::string content_uid(const std::string& bytes) {
-  auto fnv = [&](uint64_t h) {
-    for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ULL;
-    return h;
-  };
-  unsigned __int128 n =
-      (static_cast<unsigned __int128>(fnv(14695981039346656037ULL)) << 64) | fnv(0x9e3779b97f4a7c15ULL);
-  std::string digits;
-  do {
-    digits.insert(digits.begin(), char('0' + int(n % 10)));
-    n /= 10;
-  } while (n != 0);
-  return "2.25." + digits;
-}
+// 128 bits of FNV-1a (two differently seeded 64-bit states), as the decimal of a UID under the 2.25 root
+// (ISO/IEC 9834-8: a UID from a 128-bit number); deterministic, unlike GDCM's generator. The volume is
+// hashed once, and each UID goes on from that state with a few bytes of its own.
+struct ContentHash {
+  uint64_t a = 14695981039346656037ULL, b = 0x9e3779b97f4a7c15ULL;
+  void add(const void* data, std::size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      a = (a ^ p[i]) * 1099511628211ULL;
+      b = (b ^ p[i]) * 1099511628211ULL;
+    }
+  }
+  std::string uid(const std::string& what) const {
+    ContentHash h = *this;
+    h.add(what.data(), what.size());
+    unsigned __int128 n = (static_cast<unsigned __int128>(h.a) << 64) | h.b;
+    std::string digits;
+    do {
+      digits.insert(digits.begin(), char('0' + int(n % 10)));
+      n /= 10;
+    } while (n != 0);
+    return "2.25." + digits;
+  }
+};
 
 void put_text(gdcm::DataSet& ds, uint16_t group, uint16_t element, gdcm::VR vr, std::string value) {
   if (value.size() % 2 != 0) value.push_back(vr == gdcm::VR::UI ? '\0' : ' ');
@@ -326,14 +334,14 @@ std::vector<std::string> write_dicom_series(const std::string& folder, const Vox
   if (!(options.slope != 0) || !std::isfinite(options.slope) || !std::isfinite(options.intercept))
     throw InputError("DICOM writer: the rescale slope must be a finite non-zero number");
   // The UIDs are made from what the series holds, so the same volume gives the same files.
-  std::string content(reinterpret_cast<const char*>(volume.values.data()),
-                      volume.values.size() * sizeof(float));
-  content.append(reinterpret_cast<const char*>(n.data()), sizeof(int) * 3);
-  content.append(reinterpret_cast<const char*>(volume.origin.data()), sizeof(double) * 3);
-  content.append(reinterpret_cast<const char*>(spacing.data()), sizeof(double) * 3);
-  const std::string study_uid = content_uid(content + "study");
-  const std::string series_uid = content_uid(content + "series");
-  const std::string frame_uid = content_uid(content + "frame");
+  ContentHash content;
+  content.add(volume.values.data(), volume.values.size() * sizeof(float));
+  content.add(n.data(), sizeof(int) * 3);
+  content.add(volume.origin.data(), sizeof(double) * 3);
+  content.add(spacing.data(), sizeof(double) * 3);
+  const std::string study_uid = content.uid("study");
+  const std::string series_uid = content.uid("series");
+  const std::string frame_uid = content.uid("frame");
 
   std::vector<std::string> names;
   const std::size_t per_slice = std::size_t(n[0]) * std::size_t(n[1]);
@@ -366,7 +374,7 @@ std::vector<std::string> write_dicom_series(const std::string& folder, const Vox
 
     gdcm::DataSet& ds = writer.GetFile().GetDataSet();
     put_text(ds, 0x0008, 0x0016, gdcm::VR::UI, "1.2.840.10008.5.1.4.1.1.2");  // CT Image Storage
-    put_text(ds, 0x0008, 0x0018, gdcm::VR::UI, content_uid(content + "slice" + std::to_string(k)));
+    put_text(ds, 0x0008, 0x0018, gdcm::VR::UI, content.uid("slice" + std::to_string(k)));
     // Left empty, or GDCM writes the time of writing into every file (the same volume, other bytes).
     put_text(ds, 0x0008, 0x0020, gdcm::VR::DA, "");  // study date and time
     put_text(ds, 0x0008, 0x0030, gdcm::VR::TM, "");
