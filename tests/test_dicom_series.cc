@@ -1,5 +1,8 @@
 // CT volumes as DICOM series (mesher/dicom_series.h): written, read back, cross-checked with VTK's own
 // DICOM reader, and every folder a scanner export can get wrong refused with the file named.
+#include <gdcmImageChangeTransferSyntax.h>
+#include <gdcmImageReader.h>
+#include <gdcmImageWriter.h>
 #include <gtest/gtest.h>
 #include <vtkDICOMImageReader.h>
 #include <vtkImageData.h>
@@ -106,6 +109,38 @@ TEST(DicomSeries, VtksOwnDicomReaderSeesTheSameGrid) {
   EXPECT_NEAR(spacing[1], 0.5, 1e-6);
   EXPECT_NEAR(reader->GetRescaleSlope(), 0.5, 1e-9);
   EXPECT_NEAR(reader->GetRescaleOffset(), -1024, 1e-9);
+}
+
+// PACS exports are often compressed: the slices re-encoded as JPEG lossless, JPEG 2000 lossless and RLE
+// (GDCM's codecs) read back to the same values.
+TEST(DicomSeries, CompressedSlicesReadBackToTheSameValues) {
+  const VoxelVolume v = test_volume();
+  const std::string dir = written_series(v);
+  const gdcm::TransferSyntax::TSType syntaxes[] = {gdcm::TransferSyntax::JPEGLosslessProcess14_1,
+                                                   gdcm::TransferSyntax::JPEG2000Lossless,
+                                                   gdcm::TransferSyntax::RLELossless};
+  int k = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string file = entry.path().string();
+    gdcm::ImageReader reader;
+    reader.SetFileName(file.c_str());
+    ASSERT_TRUE(reader.Read()) << file;
+    gdcm::ImageChangeTransferSyntax change;
+    const gdcm::TransferSyntax::TSType syntax = syntaxes[k++ % 3];
+    change.SetTransferSyntax(syntax);
+    change.SetInput(reader.GetImage());
+    ASSERT_TRUE(change.Change()) << file;
+    gdcm::ImageWriter writer;
+    writer.SetFileName(file.c_str());
+    writer.SetFile(reader.GetFile());
+    writer.SetImage(change.GetOutput());
+    ASSERT_TRUE(writer.Write()) << file;
+    gdcm::ImageReader check;  // the file is compressed now, not a copy of the plain one
+    check.SetFileName(file.c_str());
+    ASSERT_TRUE(check.Read()) << file;
+    EXPECT_EQ(check.GetFile().GetHeader().GetDataSetTransferSyntax(), gdcm::TransferSyntax(syntax)) << file;
+  }
+  expect_same_volume(read_volume(dir), v);
 }
 
 // Scanners name their files anyhow (by UID, by acquisition time): the order comes from the slices'
