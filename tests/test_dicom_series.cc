@@ -3,6 +3,8 @@
 #include <gdcmImageChangeTransferSyntax.h>
 #include <gdcmImageReader.h>
 #include <gdcmImageWriter.h>
+#include <gdcmReader.h>
+#include <gdcmWriter.h>
 #include <gtest/gtest.h>
 #include <vtkDICOMImageReader.h>
 #include <vtkImageData.h>
@@ -141,6 +143,53 @@ TEST(DicomSeries, CompressedSlicesReadBackToTheSameValues) {
     EXPECT_EQ(check.GetFile().GetHeader().GetDataSetTransferSyntax(), gdcm::TransferSyntax(syntax)) << file;
   }
   expect_same_volume(read_volume(dir), v);
+}
+
+// Replaces a text tag of a DICOM file in place (DICOM pads text to an even length with a space).
+void set_tag(const std::string& file, uint16_t group, uint16_t element, std::string value) {
+  gdcm::Reader reader;
+  reader.SetFileName(file.c_str());
+  ASSERT_TRUE(reader.Read()) << file;
+  if (value.size() % 2 != 0) value += ' ';
+  gdcm::DataElement de(gdcm::Tag(group, element));
+  de.SetVR(gdcm::VR::DS);
+  de.SetByteValue(value.data(), static_cast<uint32_t>(value.size()));
+  reader.GetFile().GetDataSet().Replace(de);
+  gdcm::Writer writer;
+  writer.SetFileName(file.c_str());
+  writer.SetFile(reader.GetFile());
+  ASSERT_TRUE(writer.Write()) << file;
+}
+
+// A series stored with its rows running toward the patient's right and its columns anterior (orientation
+// -1\0\0\0\-1\0, as some scanners write a prone scan), placed by its last pixel: the same positions hold
+// the pixels mirrored in x and y. Reading it must mirror them back into place: a reader that ignored the
+// orientation would swap the patient's left and right without a word.
+TEST(DicomSeries, ReversedRowAndColumnDirectionsAreMirroredIntoPlace) {
+  const VoxelVolume v = test_volume();
+  const std::string dir = written_series(v);
+  const Vec3 h = v.spacing_xyz();
+  const double x_last = v.origin[0] + (v.dims[0] - 1) * h[0], y_last = v.origin[1] + (v.dims[1] - 1) * h[1];
+  for (int k = 0; k < v.dims[2]; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/ct_%04d.dcm", k + 1);
+    char position[96];
+    std::snprintf(position, sizeof position, "%.6f\\%.6f\\%.6f", x_last, y_last, v.origin[2] + k * h[2]);
+    set_tag(dir + name, 0x0020, 0x0037, "-1\\0\\0\\0\\-1\\0");
+    set_tag(dir + name, 0x0020, 0x0032, position);
+  }
+  const VoxelVolume back = read_volume(dir);
+  ASSERT_EQ(back.dims, v.dims);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(back.origin[a], v.origin[a], 1e-5) << a;
+  const auto at = [](const VoxelVolume& w, int i, int j, int k) {
+    return w.values[(std::size_t(k) * w.dims[1] + j) * w.dims[0] + i];
+  };
+  int mismatches = 0;
+  for (int k = 0; k < v.dims[2]; ++k)
+    for (int j = 0; j < v.dims[1]; ++j)
+      for (int i = 0; i < v.dims[0]; ++i)
+        mismatches += at(back, i, j, k) != at(v, v.dims[0] - 1 - i, v.dims[1] - 1 - j, k);
+  EXPECT_EQ(mismatches, 0);
 }
 
 // Scanners name their files anyhow (by UID, by acquisition time): the order comes from the slices'
