@@ -33,7 +33,8 @@ void run_from_ct(const FromCtArgs& args) {
 
   const auto start = std::chrono::steady_clock::now();
   Progress progress("extract surface");
-  const VoxelVolume volume = read_volume(args.volume);
+  VolumeInfo source;
+  const VoxelVolume volume = read_volume(args.volume, &source);
   CtExtraction dropped;
   TriSurface surface;
   try {
@@ -55,6 +56,9 @@ void run_from_ct(const FromCtArgs& args) {
                   a[2] * (b[0] * c[1] - b[1] * c[0]);
   }
   const Vec3 h = volume.spacing_xyz();
+  if (!source.description.empty()) info(source.description);
+  for (const std::string& sentence : source.warnings)
+    std::fprintf(stderr, "hexbite: warning: '%s': %s.\n", args.volume.c_str(), sentence.c_str());
   char buf[512];
   std::snprintf(buf, sizeof buf, "volume %d x %d x %d voxels of %g x %g x %g mm, threshold %g",
                 volume.dims[0], volume.dims[1], volume.dims[2], h[0], h[1], h[2], args.threshold);

@@ -85,8 +85,10 @@ Geometry build_geometry(const Scenario& s) {
       break;
     case GeometrySource::kCt: {
       CtExtraction dropped;
+      VolumeInfo source;
       try {
-        g.surface = surface_from_volume(read_volume(s.geometry.file), s.geometry.threshold, &dropped);
+        g.surface =
+            surface_from_volume(read_volume(s.geometry.file, &source), s.geometry.threshold, &dropped);
       } catch (const InputError& e) {
         const std::string what = e.what();
         // read_volume names the file; the threshold's messages speak of "the volume".
@@ -94,6 +96,7 @@ Geometry build_geometry(const Scenario& s) {
                          (what.find(s.geometry.file) == std::string::npos ? s.geometry.file + ": " : "") +
                          what);
       }
+      for (const std::string& sentence : source.warnings) warn(s.geometry.file + ": " + sentence);
       for (const std::string& sentence : describe_dropped(dropped, s.geometry.threshold))
         warn(s.geometry.file + ": " + sentence);
       // Marching cubes gives a closed surface by construction, but the same checks as for a surface file

@@ -257,8 +257,22 @@ void drop_equal_axis_spacing(VoxelVolume& v) {
 
 // A DICOM series (mesher/dicom_series.h) as a volume: its slices' placement, in patient coordinates (LPS,
 // hexbite's frame), through the same axis-aligned placement as the files' orientation matrices.
-VoxelVolume volume_from_dicom(const std::string& folder) {
+VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info) {
   DicomSeries series = read_dicom_series(folder);
+  if (info) {
+    info->description = "DICOM series '" +
+                        (series.description.empty() ? series.series_uid : series.description) + "' (" +
+                        (series.modality.empty() ? "no modality" : series.modality) + "), " +
+                        std::to_string(series.dims[2]) + " slices";
+    if (series.other_files > 0)
+      info->warnings.push_back("left out " + std::to_string(series.other_files) + " file" +
+                               (series.other_files == 1 ? "" : "s") + " of the folder that " +
+                               (series.other_files == 1 ? "is" : "are") + " no DICOM image");
+    if (series.modality != "CT")
+      info->warnings.push_back("the series' modality is " +
+                               (series.modality.empty() ? std::string("not given") : series.modality) +
+                               ", not CT: the threshold is in its own units, not Hounsfield units");
+  }
   VoxelVolume v;
   v.dims = series.dims;
   v.values = std::move(series.values);
@@ -276,9 +290,9 @@ VoxelVolume volume_from_dicom(const std::string& folder) {
 
 }  // namespace
 
-VoxelVolume read_volume(const std::string& path) {
+VoxelVolume read_volume(const std::string& path, VolumeInfo* info) {
   if (!fs::exists(path)) throw InputError("volume file '" + path + "' does not exist");
-  if (fs::is_directory(path)) return volume_from_dicom(path);
+  if (fs::is_directory(path)) return volume_from_dicom(path, info);
   // One file of a DICOM series (the preamble's "DICM" at byte 128), given instead of its folder.
   char magic[4] = {};
   std::ifstream(path, std::ios::binary).seekg(128).read(magic, 4);

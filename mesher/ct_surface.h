@@ -9,9 +9,16 @@
 
 namespace hexbite {
 
+// What a reader can tell about its input beyond the voxels, for the commands' reports.
+struct VolumeInfo {
+  std::string description;  // a DICOM series: "DICOM series 'BONE 0.6' (CT), 318 slices"; else empty
+  std::vector<std::string> warnings;  // sentences: files of the folder left out, a series that is no CT
+};
+
 // Reads MetaImage (.mha/.mhd), NIfTI (.nii/.nii.gz) or, given a folder, the DICOM series in it
-// (mesher/dicom_series.h); throws InputError naming the file or folder otherwise.
-VoxelVolume read_volume(const std::string& path);
+// (mesher/dicom_series.h); throws InputError naming the file or folder otherwise. `info`, when given,
+// receives what the reader can tell about the input.
+VoxelVolume read_volume(const std::string& path, VolumeInfo* info = nullptr);
 
 // What the extraction left out: the iso-surface's other connected pieces, told apart by the sign
 // of their enclosed volume (marching cubes orients every piece the same way relative to the

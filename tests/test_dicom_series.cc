@@ -146,13 +146,14 @@ TEST(DicomSeries, CompressedSlicesReadBackToTheSameValues) {
 }
 
 // Replaces a text tag of a DICOM file in place (DICOM pads text to an even length with a space).
-void set_tag(const std::string& file, uint16_t group, uint16_t element, std::string value) {
+void set_tag(const std::string& file, uint16_t group, uint16_t element, std::string value,
+             gdcm::VR vr = gdcm::VR::DS) {
   gdcm::Reader reader;
   reader.SetFileName(file.c_str());
   ASSERT_TRUE(reader.Read()) << file;
   if (value.size() % 2 != 0) value += ' ';
   gdcm::DataElement de(gdcm::Tag(group, element));
-  de.SetVR(gdcm::VR::DS);
+  de.SetVR(vr);
   de.SetByteValue(value.data(), static_cast<uint32_t>(value.size()));
   reader.GetFile().GetDataSet().Replace(de);
   gdcm::Writer writer;
@@ -190,6 +191,23 @@ TEST(DicomSeries, ReversedRowAndColumnDirectionsAreMirroredIntoPlace) {
       for (int i = 0; i < v.dims[0]; ++i)
         mismatches += at(back, i, j, k) != at(v, v.dims[0] - 1 - i, v.dims[1] - 1 - j, k);
   EXPECT_EQ(mismatches, 0);
+}
+
+// `surface from-ct` says which series it read, and warns of the files it left out and of a series that is
+// no CT (whose threshold is then not in Hounsfield units).
+TEST(DicomSeries, FromCtNamesTheSeriesAndWarnsOfWhatItLeftOut) {
+  const std::string dir = written_series();
+  test::write_file(dir + "/README.txt", "exported by the scanner\n");
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().extension() == ".dcm")
+      set_tag(entry.path().string(), 0x0008, 0x0060, "MR", gdcm::VR::CS);
+  const auto r = test::run_hexbite({"surface", "from-ct", dir, "--threshold", "0", "-o", dir + "/../mr.stl"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("DICOM series 'hexbite CT-like volume' (MR), 7 slices"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("left out 1 file of the folder that is no DICOM image"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the series' modality is MR, not CT: the threshold is in its own units"),
+            std::string::npos)
+      << r.err;
 }
 
 // Scanners name their files anyhow (by UID, by acquisition time): the order comes from the slices'
