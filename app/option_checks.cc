@@ -51,6 +51,16 @@ std::string out_of_range(const std::string& value, double lo, double hi, const s
   return {};
 }
 
+// Why no new entry can be made in the existing folder `dir` (a read-only file system, /proc), or empty when
+// one can: a hidden folder is made there and at once removed, as the outputs' stages and temporary files
+// are made there later.
+std::string cannot_make_entries(const fs::path& dir) {
+  std::string probe = (dir / ".hexbite-probe-XXXXXX").string();
+  if (::mkdtemp(probe.data()) == nullptr) return std::strerror(errno);
+  ::rmdir(probe.c_str());
+  return {};
+}
+
 }  // namespace
 
 CLI::Validator count_in_range(long lo, long hi) {
@@ -91,8 +101,13 @@ CLI::Validator output_file(std::vector<std::string> extensions) {
                  "' does not exist; create it first";
         const std::string name = lower(path.filename().string());
         for (const std::string& ext : extensions)
-          if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0)
-            return {};
+          if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0) {
+            // The file is written to a temporary name beside it first, so the folder must take new entries.
+            const std::string refused = cannot_make_entries(dir);
+            if (refused.empty()) return {};
+            return "cannot write '" + value + "': no file can be made in '" + dir.string() + "' (" + refused +
+                   "); give a path in a folder you can write to";
+          }
         return "'" + value + "': this command writes " + listed(extensions) +
                "; give a file name ending in " +
                (extensions.size() == 1 ? extensions.front() : "one of them");
@@ -130,13 +145,10 @@ CLI::Validator output_folder() {
         if (!fs::is_directory(existing, ec))
           return "cannot create the output folder '" + value + "': '" + existing.string() +
                  "' is a file, not a folder; " + give;
-        // The run's stage is a folder made there, so making (and at once removing) one is the test.
-        std::string probe = (existing / ".hexbite-probe-XXXXXX").string();
-        if (::mkdtemp(probe.data()) == nullptr)
-          return "cannot create the output folder '" + value + "': no folder can be made in '" +
-                 existing.string() + "' (" + std::strerror(errno) + "); give a folder you can write to";
-        ::rmdir(probe.c_str());
-        return {};
+        const std::string refused = cannot_make_entries(existing);
+        if (refused.empty()) return {};
+        return "cannot create the output folder '" + value + "': no folder can be made in '" +
+               existing.string() + "' (" + refused + "); give a folder you can write to";
       },
       "");
 }

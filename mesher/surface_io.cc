@@ -842,8 +842,10 @@ std::string ply_bytes(const TriSurface& s) {
   return out;
 }
 
-// Writes `s` to tmp_path, the temporary of path (named in the error).
-void write_vtp(const std::string& tmp_path, const std::string& path, const TriSurface& s) {
+// The bytes of `s` as a binary VTK XML PolyData file; `path` is named in the error. Made in memory and then
+// written and checked like the other formats: VTK writing to the file itself did not notice a write that
+// failed (a full disk, a file size limit) and left an empty file with exit 0.
+std::string vtp_bytes(const std::string& path, const TriSurface& s) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(s.vertices.size()));
@@ -862,13 +864,13 @@ void write_vtp(const std::string& tmp_path, const std::string& path, const TriSu
 
   VtkMessageCapture capture;
   vtkNew<vtkXMLPolyDataWriter> writer;
-  writer->SetFileName(tmp_path.c_str());
+  writer->WriteToOutputStringOn();
   writer->SetInputData(data);
   writer->SetDataModeToBinary();
-  // VTK 9.1's writer returns 1 also when it could not open the file; what it printed tells.
   if (writer->Write() != 1 || !capture.errors().empty())
     throw RunError("cannot write " + quoted(path) + ": " +
                    (capture.errors().empty() ? std::string("VTK writer failed") : capture.errors()));
+  return writer->GetOutputString();
 }
 
 }  // namespace
@@ -903,12 +905,10 @@ TriSurface read_surface(const std::string& path, double scale_to_mm) {
 void write_surface(const std::string& path, const TriSurface& surface) {
   const std::string ext = lower_extension(path);
   require_known_extension(path, ext, "write");
-  if (ext == ".vtp") {
-    write_atomically(path, [&](const std::string& tmp) { write_vtp(tmp, path, surface); });
-    return;
-  }
   std::string bytes;
-  if (ext == ".stl")
+  if (ext == ".vtp")
+    bytes = vtp_bytes(path, surface);
+  else if (ext == ".stl")
     bytes = stl_bytes(surface);
   else if (ext == ".obj")
     bytes = obj_bytes(surface);

@@ -341,19 +341,32 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
 }
 
-// An output that cannot be created in a folder that exists (/proc takes no new files, also for root) is a
-// failed run (exit 1) that names the file and why. Before: a .vtp said "cannot write '/proc/x.vtp': Success"
-// (VTK's writer reported success, and the error code of the rename was cleared by the clean-up), and the
-// other formats named only the temporary file ("cannot open '/proc/.x.tmp123.stl' for writing").
+// An output in a folder that takes no new files (/proc, also for root) is refused when the command line is
+// read (exit 2); one whose write fails on the way (a full disk, here a file size limit with SIGXFSZ ignored)
+// is a failed run (exit 1) that names the file and why, and leaves no file. Before: a .vtp said "cannot
+// write '/proc/x.vtp': Success" (VTK's writer reported success, and the error code of the rename was cleared
+// by the clean-up), the other formats named only the temporary file ("cannot open '/proc/.x.tmp123.stl' for
+// writing"), and a .vtp on a full disk was an empty file with exit 0 (VTK's writer did not notice).
 TEST(CliBadInput, AnOutputThatCannotBeCreatedIsNamed) {
   const std::string cube = write_case("cube.obj", cube_obj());
+  const std::string dir = temp_dir();
   for (const char* ext : {".stl", ".vtp", ".obj"}) {
-    const std::string out = std::string("/proc/hexbite_no_such_output") + ext;
-    const auto r = run_hexbite({"surface", "check", cube, "-o", out});
-    EXPECT_EQ(r.exit_code, 1) << r.err;
-    EXPECT_EQ(r.err.rfind("hexbite: failed: cannot write '" + out + "': ", 0), 0u) << r.err;
-    EXPECT_EQ(r.err.find("Success"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("No such file or directory"), std::string::npos) << r.err;
+    const std::string in_proc = std::string("/proc/hexbite_no_such_output") + ext;
+    auto r = run_hexbite({"surface", "check", cube, "-o", in_proc});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("cannot write '" + in_proc +
+                         "': no file can be made in '/proc' (No such file or directory)"),
+              std::string::npos)
+        << r.err;
+
+    // The real jaw's 41,760 triangles do not fit in 1 kB; the one-line message on standard error does.
+    const std::string out = dir + "/full" + ext;
+    r = run_hexbite(
+        {"-q", "surface", "check", std::string(HEXBITE_SHARED_DATA) + "/jaw/jaw_smooth.stl", "-o", out},
+        {"bash", "-c", "trap '' XFSZ; ulimit -f 1; exec \"$@\"", "bash"});
+    EXPECT_EQ(r.exit_code, 1) << ext << " " << r.err;
+    EXPECT_EQ(r.err, "hexbite: failed: cannot write '" + out + "': disk full or not writable\n") << r.err;
+    EXPECT_TRUE(fs::is_empty(dir)) << ext;
   }
 }
 

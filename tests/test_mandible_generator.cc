@@ -668,18 +668,27 @@ TEST(Cli, GenerateRejectsBadOptionsWithoutWritingAnything) {
 }
 
 // The outputs of generate are one set: a write that fails leaves none of them, and earlier files of those
-// names as they were. Before, a CT that could not be written (here into /proc, which takes no new files,
-// also for root) left the new surface and landmarks beside the old CT, exit 1; and a surface that did not
-// fit on the disk (a 500 kB file-size limit, SIGXFSZ ignored so that the write fails as on a full disk)
-// must be named by its own path, not by the stage it is written into.
+// names as they were. Before, a CT that could not be written left the new surface and landmarks beside the
+// old CT, exit 1; here the CT is the one output that does not fit (a 3 MB file-size limit, SIGXFSZ ignored
+// so that the write fails as on a full disk: the 2.4 MB surface fits, the 4.4 MB NIfTI does not). A CT in a
+// folder that takes no new files (/proc, also for root) is refused when the command line is read. And a
+// surface that did not fit on the disk (500 kB) must be named by its own path, not by the stage it is
+// written into.
 TEST(Cli, GenerateWritesAllItsOutputsOrNone) {
   const std::string dir = test::temp_dir();
   test::write_file(dir + "/jaw.stl", "an earlier surface");
   const std::map<std::string, std::string> before = test::files_under(dir);
   auto r = test::run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--landmarks",
-                              dir + "/jaw.yaml", "--ct", "/proc/hexbite_no_such_ct.mha"});
+                              dir + "/jaw.yaml", "--ct", dir + "/jaw.nii"},
+                             {"bash", "-c", "trap '' XFSZ; ulimit -f 3000; exec \"$@\"", "bash"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("cannot write in the output folder '/proc'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cannot write volume '" + dir + "/jaw.nii'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("none of the outputs was written"), std::string::npos) << r.err;
+  test::expect_same_files(before, test::files_under(dir));
+  r = test::run_hexbite(
+      {"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--ct", "/proc/hexbite_no_such_ct.mha"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("no file can be made in '/proc'"), std::string::npos) << r.err;
   test::expect_same_files(before, test::files_under(dir));
 
   r = test::run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--ct", dir + "/jaw.mha"},

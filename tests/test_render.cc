@@ -147,22 +147,32 @@ TEST(Render, OptionsTheInputIgnoresAreRefused) {
   EXPECT_FALSE(fs::exists(png));
 }
 
-// A picture that cannot be written (/proc takes no new files, also for root): one line with VTK's reason.
-// Before: VTK's coloured log ("Unable to open file ...", then "Ran out of disk space") and then only
-// "cannot write '/proc/...png'".
+// A picture that cannot be written: in a folder that takes no new files (/proc, also for root) it is refused
+// when the command line is read; a write that fails on the way (a full disk, here a file size limit) is one
+// line with VTK's reason and leaves no file. Before: VTK's coloured log ("Unable to open file ...", then
+// "Ran out of disk space") and then only "cannot write '/proc/...png'".
 TEST(Render, AnUnwritablePictureIsOneCleanError) {
   const std::string dir = temp_dir();
   test::write_file(dir + "/cube.obj", test::cubes_obj(1));
-  const std::string png = "/proc/hexbite_no_such_picture.png";
-  EXPECT_EQ(
-      run_with_prefix(display_prefix(), "render '" + dir + "/cube.obj' -o " + png + " --width 64 --height 64",
-                      dir + "/log"),
-      1);
-  const std::string log = read_file(dir + "/log");
-  EXPECT_NE(log.find("hexbite: failed: cannot write '" + png + "': Unable to open file"), std::string::npos)
+  const std::string in_proc = "/proc/hexbite_no_such_picture.png";
+  EXPECT_EQ(run_with_prefix(display_prefix(),
+                            "render '" + dir + "/cube.obj' -o " + in_proc + " --width 64 --height 64",
+                            dir + "/log"),
+            2);
+  std::string log = read_file(dir + "/log");
+  EXPECT_NE(log.find("cannot write '" + in_proc + "': no file can be made in '/proc'"), std::string::npos)
+      << log;
+
+  const std::string png = dir + "/full.png";
+  EXPECT_EQ(run_with_prefix(display_prefix() + " bash -c 'trap \"\" XFSZ; ulimit -f 1; exec \"$@\"' bash",
+                            "render '" + dir + "/cube.obj' -o '" + png + "' --width 400 --height 300",
+                            dir + "/log"),
+            1);
+  log = read_file(dir + "/log");
+  EXPECT_NE(log.find("hexbite: failed: cannot write '" + png + "': Ran out of disk space"), std::string::npos)
       << log;
   EXPECT_EQ(log.find("\x1b["), std::string::npos) << log;  // no terminal colour codes
-  EXPECT_EQ(log.find("disk space"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(png));
 }
 
 TEST(Render, WithoutDisplayFailsClearlyAndWritesNothing) {
