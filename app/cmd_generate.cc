@@ -175,8 +175,8 @@ void run_generate(const GenerateArgs& args) {
   info(buf);
   info("wrote " + args.output + ", " + landmark_path + (args.ct.empty() ? "" : ", " + args.ct) +
        (args.dicom.empty() ? ""
-                           : ", " + args.dicom + "/ (a DICOM series of " + std::to_string(jaw.ct.dims[2]) +
-                                 " slices, ct_0001.dcm ...)"));
+                           : ", " + (fs::path(args.dicom) / "ct_0001.dcm").lexically_normal().string() +
+                                 " ... (a DICOM series of " + std::to_string(jaw.ct.dims[2]) + " slices)"));
 }
 
 // "Body height at the first molar in mm, 8 to 40 (default: dentate 27, edentulous 21, atrophic 12)": the
