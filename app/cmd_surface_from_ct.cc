@@ -19,7 +19,7 @@ namespace hexbite {
 namespace {
 
 struct FromCtArgs {
-  std::string volume, output;
+  std::string volume, output, series;
   double threshold = 0;
 };
 
@@ -34,7 +34,7 @@ void run_from_ct(const FromCtArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress("extract surface");
   VolumeInfo source;
-  const VoxelVolume volume = read_volume(args.volume, &source);
+  const VoxelVolume volume = read_volume(args.volume, &source, args.series);
   CtExtraction dropped;
   TriSurface surface;
   try {
@@ -93,6 +93,9 @@ void add_surface_from_ct_command(CLI::App& surface) {
       ->required()
       ->check(number_in_range(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
                               "that is finite, in the volume's units (e.g. 620 Hounsfield units)"));
+  cmd->add_option("--series", args->series,
+                  "In a folder holding several DICOM series, the one to read: its Series Number, Series "
+                  "Description or Series Instance UID");
   cmd->add_option("-o,--output", args->output, "Surface file to write (STL, OBJ, PLY, OFF, VTP)")
       ->required()
       ->check(output_surface_file());

@@ -87,8 +87,8 @@ Geometry build_geometry(const Scenario& s) {
       CtExtraction dropped;
       VolumeInfo source;
       try {
-        g.surface =
-            surface_from_volume(read_volume(s.geometry.file, &source), s.geometry.threshold, &dropped);
+        g.surface = surface_from_volume(read_volume(s.geometry.file, &source, s.geometry.dicom_series),
+                                        s.geometry.threshold, &dropped);
       } catch (const InputError& e) {
         const std::string what = e.what();
         // read_volume names the file; the threshold's messages speak of "the volume".

@@ -257,11 +257,11 @@ void drop_equal_axis_spacing(VoxelVolume& v) {
 
 // A DICOM series (mesher/dicom_series.h) as a volume: its slices' placement, in patient coordinates (LPS,
 // hexbite's frame), through the same axis-aligned placement as the files' orientation matrices.
-VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info) {
-  DicomSeries series = read_dicom_series(folder);
+VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info, const std::string& wanted) {
+  DicomSeries series = read_dicom_series(folder, wanted);
   if (info) {
-    info->description = "DICOM series '" +
-                        (series.description.empty() ? series.series_uid : series.description) + "' (" +
+    info->description = "DICOM series " + (series.series_number.empty() ? "" : series.series_number + " ") +
+                        "'" + (series.description.empty() ? series.series_uid : series.description) + "' (" +
                         (series.modality.empty() ? "no modality" : series.modality) + "), " +
                         std::to_string(series.dims[2]) + " slices";
     if (series.other_files > 0)
@@ -290,9 +290,12 @@ VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info) {
 
 }  // namespace
 
-VoxelVolume read_volume(const std::string& path, VolumeInfo* info) {
+VoxelVolume read_volume(const std::string& path, VolumeInfo* info, const std::string& dicom_series) {
   if (!fs::exists(path)) throw InputError("volume file '" + path + "' does not exist");
-  if (fs::is_directory(path)) return volume_from_dicom(path, info);
+  if (fs::is_directory(path)) return volume_from_dicom(path, info, dicom_series);
+  if (!dicom_series.empty())
+    throw InputError("'" + path + "' is a volume file, not a folder of DICOM slices: a DICOM series ('" +
+                     dicom_series + "') is chosen only in a folder; leave it out");
   // One file of a DICOM series (the preamble's "DICM" at byte 128), given instead of its folder.
   char magic[4] = {};
   std::ifstream(path, std::ios::binary).seekg(128).read(magic, 4);

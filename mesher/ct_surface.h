@@ -16,9 +16,11 @@ struct VolumeInfo {
 };
 
 // Reads MetaImage (.mha/.mhd), NIfTI (.nii/.nii.gz) or, given a folder, the DICOM series in it
-// (mesher/dicom_series.h); throws InputError naming the file or folder otherwise. `info`, when given,
-// receives what the reader can tell about the input.
-VoxelVolume read_volume(const std::string& path, VolumeInfo* info = nullptr);
+// (mesher/dicom_series.h): the only series there, or the one `dicom_series` names (its number, description
+// or UID; refused for a volume file). Throws InputError naming the file or folder otherwise. `info`, when
+// given, receives what the reader can tell about the input.
+VoxelVolume read_volume(const std::string& path, VolumeInfo* info = nullptr,
+                        const std::string& dicom_series = {});
 
 // What the extraction left out: the iso-surface's other connected pieces, told apart by the sign
 // of their enclosed volume (marching cubes orients every piece the same way relative to the

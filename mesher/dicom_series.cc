@@ -89,8 +89,12 @@ void rescale(const std::vector<char>& buffer, double slope, double intercept, st
 }
 
 // Reads `file` as a DICOM image slice; false when it is no DICOM image (another file in the folder).
-bool read_slice(const std::string& file, const std::string& folder, Slice& slice, std::string& series_uid,
-                std::string& modality, std::string& description) {
+// The tags that tell the series of a slice apart.
+struct SeriesTags {
+  std::string uid, number, modality, description;
+};
+
+bool read_slice(const std::string& file, const std::string& folder, Slice& slice, SeriesTags& tags) {
   gdcm::ImageReader reader;
   reader.SetFileName(file.c_str());
   if (!reader.Read()) return false;
@@ -105,9 +109,10 @@ bool read_slice(const std::string& file, const std::string& folder, Slice& slice
   if (image.GetPixelFormat().GetSamplesPerPixel() != 1)
     throw InputError(where + " has " + std::to_string(image.GetPixelFormat().GetSamplesPerPixel()) +
                      " samples per pixel (a colour image); a CT slice has one");
-  series_uid = tag_text(ds, 0x0020, 0x000e);
-  modality = tag_text(ds, 0x0008, 0x0060);
-  description = tag_text(ds, 0x0008, 0x103e);
+  tags.uid = tag_text(ds, 0x0020, 0x000e);
+  tags.number = tag_text(ds, 0x0020, 0x0011);
+  tags.modality = tag_text(ds, 0x0008, 0x0060);
+  tags.description = tag_text(ds, 0x0008, 0x103e);
   const std::vector<double> position = tag_numbers(ds, 0x0020, 0x0032);
   const std::vector<double> orientation = tag_numbers(ds, 0x0020, 0x0037);
   const std::vector<double> spacing = tag_numbers(ds, 0x0028, 0x0030);
@@ -211,7 +216,7 @@ void quiet_gdcm() {
 
 }  // namespace
 
-DicomSeries read_dicom_series(const std::string& folder) {
+DicomSeries read_dicom_series(const std::string& folder, const std::string& wanted) {
   if (!fs::is_directory(folder)) throw InputError("DICOM series '" + folder + "' is not a folder");
   quiet_gdcm();
   std::vector<std::string> files;
@@ -220,36 +225,55 @@ DicomSeries read_dicom_series(const std::string& folder) {
   std::sort(files.begin(), files.end());
 
   struct Series {
-    std::string modality, description;
+    SeriesTags tags;
     std::vector<Slice> slices;
   };
   std::map<std::string, Series> series;
   DicomSeries out;
   for (const std::string& file : files) {
     Slice slice;
-    std::string uid, modality, description;
-    if (!read_slice(file, folder, slice, uid, modality, description)) {
+    SeriesTags tags;
+    if (!read_slice(file, folder, slice, tags)) {
       ++out.other_files;
       continue;
     }
-    Series& s = series[uid];
-    s.modality = modality;
-    s.description = description;
+    Series& s = series[tags.uid];
+    s.tags = tags;
     s.slices.push_back(std::move(slice));
   }
   if (series.empty())
     throw InputError("'" + folder + "' holds no DICOM image (" + counted(files.size(), "file") +
                      " read); give the folder of a CT series, one file per slice");
-  if (series.size() > 1) {
-    std::string list;
-    for (const auto& [uid, s] : series)
-      list += std::string(list.empty() ? "" : "; ") + "'" + uid + "' (" +
-              (s.description.empty() ? s.modality : s.description) + ", " +
-              counted(s.slices.size(), "slice") + ")";
-    throw InputError("'" + folder + "' holds " + std::to_string(series.size()) + " DICOM series: " + list +
-                     "; copy the files of the one to use into a folder of their own");
+  // "number 3, 'BONE 0.6', 212 slices, UID 2.25.1234" for each series, for the messages below.
+  auto listed = [&](const std::vector<Series*>& list) {
+    std::string text;
+    for (const Series* s : list)
+      text += std::string(text.empty() ? "" : "; ") + "number " +
+              (s->tags.number.empty() ? "(none)" : s->tags.number) + ", '" +
+              (s->tags.description.empty() ? s->tags.modality : s->tags.description) + "', " +
+              counted(s->slices.size(), "slice") + ", UID " + s->tags.uid;
+    return text;
+  };
+  std::vector<Series*> all, chosen;
+  for (auto& [uid, s] : series) {
+    all.push_back(&s);
+    if (!wanted.empty() && (uid == wanted || s.tags.number == wanted || s.tags.description == wanted))
+      chosen.push_back(&s);
   }
-  auto& [uid, s] = *series.begin();
+  const std::string choose =
+      "choose one by its number, description or UID (surface from-ct --series, or series: in a scenario's "
+      "ct)";
+  if (wanted.empty() && series.size() > 1)
+    throw InputError("'" + folder + "' holds " + std::to_string(series.size()) + " DICOM series (" +
+                     listed(all) + "); " + choose);
+  if (!wanted.empty() && chosen.empty())
+    throw InputError("'" + folder + "' holds no DICOM series numbered, described or identified as '" +
+                     wanted + "'; its series: " + listed(all));
+  if (chosen.size() > 1)
+    throw InputError("'" + folder + "' holds " + std::to_string(chosen.size()) + " DICOM series that '" +
+                     wanted + "' names (" + listed(chosen) + "); choose one by its UID");
+  Series& s = chosen.empty() ? series.begin()->second : *chosen.front();
+  const std::string uid = s.tags.uid;
   std::vector<Slice>& slices = s.slices;
   const std::string where = "DICOM series '" + folder + "'";
   if (slices.size() < 2) throw InputError(where + " has one slice; a volume needs at least two");
@@ -316,8 +340,9 @@ DicomSeries read_dicom_series(const std::string& folder) {
   out.first = slices.front().position;
   out.axes = {first.row, first.column, normal};
   out.series_uid = uid;
-  out.modality = s.modality;
-  out.description = s.description;
+  out.series_number = s.tags.number;
+  out.modality = s.tags.modality;
+  out.description = s.tags.description;
   out.values.reserve(std::size_t(out.dims[0]) * out.dims[1] * out.dims[2]);
   for (Slice& sl : slices) {
     out.values.insert(out.values.end(), sl.values.begin(), sl.values.end());
@@ -384,6 +409,7 @@ std::vector<std::string> write_dicom_series(const std::string& folder, const Vox
     put_text(ds, 0x0020, 0x000d, gdcm::VR::UI, study_uid);
     put_text(ds, 0x0020, 0x000e, gdcm::VR::UI, series_uid);
     put_text(ds, 0x0020, 0x0052, gdcm::VR::UI, frame_uid);
+    put_text(ds, 0x0020, 0x0011, gdcm::VR::IS, std::to_string(options.series_number));
     put_text(ds, 0x0020, 0x0013, gdcm::VR::IS, std::to_string(k + 1));
     put_text(ds, 0x0018, 0x0050, gdcm::VR::DS, std::to_string(spacing[2]));  // slice thickness
 

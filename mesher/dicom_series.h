@@ -27,21 +27,23 @@ struct DicomSeries {
   Vec3 first{};                     // Image Position (Patient) of the first slice: voxel (0, 0, 0), mm
   std::array<Vec3, 3> axes{};       // unit directions of i (the rows), j (the columns) and k (the normal)
   std::vector<float> values;        // rescaled: Hounsfield units for CT
-  std::string series_uid, modality, description;
+  std::string series_uid, series_number, modality, description;
   int other_files = 0;  // files in the folder that are no DICOM images (a DICOMDIR, notes), left out
 };
 
-// Reads the one image series in `folder` (every file in it, whatever its name; sub-folders are not read).
-// Throws InputError naming the folder (and the file) when it holds no DICOM image, more than one series
-// (each named by its UID, description and slice count), slices of different sizes, orientations or pixel
-// spacings, slices at the same place or unevenly spaced (a missing slice), or pixels of more than one
-// sample (colour).
-DicomSeries read_dicom_series(const std::string& folder);
+// Reads an image series in `folder` (every file in it, whatever its name; sub-folders are not read): the
+// only one, or the one that `series` names by its Series Instance UID, Series Number or Series Description.
+// Throws InputError naming the folder (and the file) when it holds no DICOM image, more than one series and
+// `series` is empty (each named by its number, description, slice count and UID), no series or more than
+// one of that name, slices of different sizes, orientations or pixel spacings, slices at the same place or
+// unevenly spaced (a missing slice), or pixels of more than one sample (colour).
+DicomSeries read_dicom_series(const std::string& folder, const std::string& series = {});
 
 struct DicomWriteOptions {
   double slope = 1.0;  // stored value = round((value - intercept) / slope), as signed 16-bit integers
   double intercept = 0.0;
   std::string patient_name = "hexbite^procedural mandible";
+  int series_number = 1;
 };
 
 // Writes `volume` as a CT series into the existing folder `folder`, one file per slice along z, named

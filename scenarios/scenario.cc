@@ -244,10 +244,11 @@ GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
     g.scale_to_mm = unit_to_mm(g.units);
   } else {
     g.source = GeometrySource::kCt;
-    const Map c(map.get("ct"), {"file", "threshold"});
+    const Map c(map.get("ct"), {"file", "threshold", "series"});
     g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume", true);
     g.threshold =
         to_number(c.require("threshold", "threshold: 400 (the bone iso-value, e.g. in Hounsfield units)"));
+    if (auto series = c.find("series")) g.dicom_series = to_string(*series);
   }
   return g;
 }

@@ -48,6 +48,7 @@ struct GeometrySpec {
   std::string units = "mm";     // kSurface: the file's length unit
   double scale_to_mm = 1.0;     // kSurface: unit_to_mm(units)
   double threshold = 0;         // kCt: the iso-value of the bone surface
+  std::string dicom_series;     // kCt, a folder holding several DICOM series: the one to read
   SourceLocation where;
 };
 

@@ -203,7 +203,7 @@ TEST(DicomSeries, FromCtNamesTheSeriesAndWarnsOfWhatItLeftOut) {
       set_tag(entry.path().string(), 0x0008, 0x0060, "MR", gdcm::VR::CS);
   const auto r = test::run_hexbite({"surface", "from-ct", dir, "--threshold", "0", "-o", dir + "/../mr.stl"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("DICOM series 'hexbite CT-like volume' (MR), 7 slices"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("DICOM series 1 'hexbite CT-like volume' (MR), 7 slices"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("left out 1 file of the folder that is no DICOM image"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("the series' modality is MR, not CT: the threshold is in its own units"),
             std::string::npos)
@@ -264,20 +264,51 @@ TEST(DicomSeries, ADuplicateSliceIsNamed) {
   EXPECT_NE(e.find("'copy.dcm'"), std::string::npos) << e;
 }
 
-// Two series in one folder (a scout and the bone kernel, say): refused with both named, not mixed.
-TEST(DicomSeries, TwoSeriesInOneFolderAreNamedNotMixed) {
-  const std::string dir = written_series();
+// Two series in one folder (a scout and the bone kernel, say): refused with both named, not mixed; one of
+// them is chosen by its Series Number or UID (their descriptions are the same here, so that names both).
+TEST(DicomSeries, TwoSeriesInOneFolderAreNamedNotMixedAndOneIsChosen) {
+  const VoxelVolume first = test_volume();
+  const std::string dir = written_series(first);
   const std::string other = test::temp_dir() + "/other";
   fs::create_directories(other);
-  VoxelVolume second = test_volume();
-  second.values[0] += 1;  // other content, so other UIDs
-  write_dicom_series(other, second, rescaled());
+  const VoxelVolume second = test_volume(12, 9, 5);
+  DicomWriteOptions numbered = rescaled();
+  numbered.series_number = 2;
+  write_dicom_series(other, second, numbered);
   for (const auto& e : fs::directory_iterator(other))
     fs::copy_file(e.path(), dir + "/b_" + e.path().filename().string());
   const std::string e = error_of(dir);
-  EXPECT_NE(e.find("holds 2 DICOM series: '2.25."), std::string::npos) << e;
-  EXPECT_NE(e.find("(hexbite CT-like volume, 7 slices)"), std::string::npos) << e;
-  EXPECT_NE(e.find("copy the files of the one to use into a folder of their own"), std::string::npos) << e;
+  EXPECT_NE(e.find("holds 2 DICOM series (number "), std::string::npos) << e;
+  EXPECT_NE(e.find("number 1, 'hexbite CT-like volume', 7 slices, UID 2.25."), std::string::npos) << e;
+  EXPECT_NE(e.find("number 2, 'hexbite CT-like volume', 5 slices, UID 2.25."), std::string::npos) << e;
+  EXPECT_NE(e.find("choose one by its number, description or UID"), std::string::npos) << e;
+
+  expect_same_volume(read_volume(dir, nullptr, "1"), first);
+  const DicomSeries by_number = read_dicom_series(dir, "2");
+  EXPECT_EQ(by_number.dims[2], 5);
+  expect_same_volume(read_volume(dir, nullptr, by_number.series_uid), second);
+  std::string named;
+  try {
+    read_dicom_series(dir, "hexbite CT-like volume");
+  } catch (const InputError& x) {
+    named = x.what();
+  }
+  EXPECT_NE(named.find("holds 2 DICOM series that 'hexbite CT-like volume' names"), std::string::npos)
+      << named;
+  std::string none;
+  try {
+    read_dicom_series(dir, "7");
+  } catch (const InputError& x) {
+    none = x.what();
+  }
+  EXPECT_NE(none.find("holds no DICOM series numbered, described or identified as '7'; its series: number 1"),
+            std::string::npos)
+      << none;
+  // The command line and a volume file.
+  const auto r = test::run_hexbite(
+      {"-q", "surface", "from-ct", dir, "--series", "2", "--threshold", "-500", "-o", other + "/../two.stl"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THROW(read_volume(other + "/ct_0001.dcm", nullptr, "2"), InputError);
 }
 
 TEST(DicomSeries, ASingleSliceIsNoVolume) {

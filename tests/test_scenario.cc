@@ -245,6 +245,9 @@ TEST(Scenario, RelativeFilesAreResolvedAgainstTheScenarioFolder) {
   test::write_file(dir + "/ct.yaml", replace(kValid, "mandible: {variant: dentate}",
                                              "ct: {file: data/ct_series, threshold: 400}"));
   EXPECT_EQ(load_scenario(dir + "/ct.yaml").geometry.file, (fs::path(dir) / "data/ct_series").string());
+  test::write_file(dir + "/ct3.yaml", replace(kValid, "mandible: {variant: dentate}",
+                                              "ct: {file: data/ct_series, threshold: 400, series: 3}"));
+  EXPECT_EQ(load_scenario(dir + "/ct3.yaml").geometry.dicom_series, "3");
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: " + dir + "/data}")), 3,
       "does not exist or is not a file; give a path");
