@@ -20,4 +20,8 @@ std::string format_significant(double value) {
   return out.str();
 }
 
+std::string format_counted(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
 }  // namespace hexbite

@@ -1,6 +1,7 @@
 // Numbers in the text tables that commands print, and in messages.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace hexbite {
@@ -14,5 +15,8 @@ std::string format_table_number(double value, int decimals, int width);
 // `value` as a stream prints it by default, with up to 6 significant digits: "96", "0.25", "1e+06". For
 // the numbers that a message about an input quotes back.
 std::string format_significant(double value);
+
+// `n` and the noun, plural when n is not 1: "1 file", "3 files" (nouns that take an "s").
+std::string format_counted(std::size_t n, const std::string& noun);
 
 }  // namespace hexbite

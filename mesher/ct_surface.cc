@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/number_format.h"
 #include "common/paths.h"
 #include "mesher/dicom_series.h"
 #include "mesher/vtk_messages.h"
@@ -265,9 +266,9 @@ VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info, const
                         (series.modality.empty() ? "no modality" : series.modality) + "), " +
                         std::to_string(series.dims[2]) + " slices";
     if (series.other_files > 0)
-      info->warnings.push_back("left out " + std::to_string(series.other_files) + " file" +
-                               (series.other_files == 1 ? "" : "s") + " of the folder that " +
-                               (series.other_files == 1 ? "is" : "are") + " no DICOM image");
+      info->warnings.push_back("left out " + format_counted(std::size_t(series.other_files), "file") +
+                               " of the folder that " + (series.other_files == 1 ? "is" : "are") +
+                               " no DICOM image");
     if (series.modality != "CT")
       info->warnings.push_back("the series' modality is " +
                                (series.modality.empty() ? std::string("not given") : series.modality) +

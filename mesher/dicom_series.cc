@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/number_format.h"
 
 namespace hexbite {
 namespace {
@@ -63,11 +64,6 @@ double dot3(const Vec3& a, const Vec3& b) {
 
 Vec3 cross3(const Vec3& a, const Vec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-
-// "1 file", "3 files".
-std::string counted(std::size_t n, const std::string& noun) {
-  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
 
 std::string mm(double x) {
@@ -242,7 +238,7 @@ DicomSeries read_dicom_series(const std::string& folder, const std::string& want
     s.slices.push_back(std::move(slice));
   }
   if (series.empty())
-    throw InputError("'" + folder + "' holds no DICOM image (" + counted(files.size(), "file") +
+    throw InputError("'" + folder + "' holds no DICOM image (" + format_counted(files.size(), "file") +
                      " read); give the folder of a CT series, one file per slice");
   // "number 3, 'BONE 0.6', 212 slices, UID 2.25.1234" for each series, for the messages below.
   auto listed = [&](const std::vector<Series*>& list) {
@@ -251,7 +247,7 @@ DicomSeries read_dicom_series(const std::string& folder, const std::string& want
       text += std::string(text.empty() ? "" : "; ") + "number " +
               (s->tags.number.empty() ? "(none)" : s->tags.number) + ", '" +
               (s->tags.description.empty() ? s->tags.modality : s->tags.description) + "', " +
-              counted(s->slices.size(), "slice") + ", UID " + s->tags.uid;
+              format_counted(s->slices.size(), "slice") + ", UID " + s->tags.uid;
     return text;
   };
   std::vector<Series*> all, chosen;
