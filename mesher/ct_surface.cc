@@ -447,8 +447,11 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
   if (!errors.message.empty() || !fs::exists(tmp)) {
     fs::remove(tmp, ec);
     if (fmt.extension == ".mhd" || fmt.extension == ".MHD") fs::remove(raw, ec);
-    throw RunError("cannot write volume '" + path + "'" +
-                   (errors.message.empty() ? std::string() : ": " + first_line(errors.message)));
+    // VTK's writers add ", removing incomplete file .NAME.tmpPID.nii": the temporary name means nothing to
+    // the user, whose file of that name is untouched.
+    std::string reason = first_line(errors.message);
+    reason = reason.substr(0, reason.find(", removing incomplete file"));
+    throw RunError("cannot write volume '" + path + "'" + (reason.empty() ? std::string() : ": " + reason));
   }
   fs::rename(tmp, target, ec);
   if (ec) {

@@ -19,6 +19,7 @@
 #include <vtkScalarBarActor.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkWindowToImageFilter.h>
 #include <vtkXMLPUnstructuredGridReader.h>
@@ -126,20 +127,23 @@ void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& pn
   grab->SetInput(window);
   grab->ReadFrontBufferOff();
   grab->Update();
-  write_atomically(png_path, [&](const std::string& tmp) {
-    // What VTK says goes into the error, not to the terminal as its coloured log; its first error is the
-    // reason (the follow-up "Ran out of disk space" is said of any file that could not be opened).
-    VtkMessageCapture capture;
+  // Encoded in memory and written like every other output: libpng's own complaints about a failed file
+  // write ("libpng error: Write Error") went to the terminal beside our message.
+  std::string png;
+  {
+    VtkMessageCapture capture;  // what VTK says goes into the error, not to the terminal as its coloured log
     vtkNew<vtkPNGWriter> writer;
-    writer->SetFileName(tmp.c_str());
+    writer->WriteToMemoryOn();
     writer->SetInputConnection(grab->GetOutputPort());
     writer->Write();
-    if (writer->GetErrorCode() != 0 || !capture.errors().empty())
-      throw RunError("cannot write '" + png_path + "'" +
-                     (capture.errors().empty()
-                          ? std::string()
-                          : ": " + capture.errors().substr(0, capture.errors().find("; "))));
-  });
+    vtkUnsignedCharArray* bytes = writer->GetResult();
+    if (writer->GetErrorCode() != 0 || !capture.errors().empty() || bytes == nullptr)
+      throw RunError("cannot encode the picture '" + png_path + "'" +
+                     (capture.errors().empty() ? std::string() : ": " + capture.errors()));
+    png.assign(reinterpret_cast<const char*>(bytes->GetPointer(0)),
+               static_cast<std::size_t>(bytes->GetNumberOfValues()));
+  }
+  write_file_atomically(png_path, png);
 }
 
 }  // namespace
