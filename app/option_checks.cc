@@ -61,6 +61,18 @@ std::string cannot_make_entries(const fs::path& dir) {
   return {};
 }
 
+// Why a name of `path` below the existing folder `existing` is longer than that folder's file system allows
+// (255 bytes on most), or empty: found only when the outputs are written, after the work, otherwise.
+std::string name_too_long(const fs::path& existing, const fs::path& path) {
+  const long limit = ::pathconf(existing.c_str(), _PC_NAME_MAX);
+  const std::size_t most = limit > 0 ? static_cast<std::size_t>(limit) : 255;
+  for (const fs::path& part : path.lexically_relative(existing))
+    if (part.string().size() > most)
+      return "a name in it is " + std::to_string(part.string().size()) + " bytes long, more than the " +
+             std::to_string(most) + " that its file system allows; give a shorter name";
+  return {};
+}
+
 }  // namespace
 
 CLI::Validator count_in_range(long lo, long hi) {
@@ -102,6 +114,8 @@ CLI::Validator output_file(std::vector<std::string> extensions) {
         const std::string name = lower(path.filename().string());
         for (const std::string& ext : extensions)
           if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0) {
+            const std::string long_name = name_too_long(dir, path);
+            if (!long_name.empty()) return "cannot write '" + value + "': " + long_name;
             // The file is written to a temporary name beside it first, so the folder must take new entries.
             const std::string refused = cannot_make_entries(dir);
             if (refused.empty()) return {};
@@ -145,6 +159,8 @@ CLI::Validator output_folder() {
         if (!fs::is_directory(existing, ec))
           return "cannot create the output folder '" + value + "': '" + existing.string() +
                  "' is a file, not a folder; " + give;
+        const std::string long_name = name_too_long(existing, value);
+        if (!long_name.empty()) return "cannot create the output folder '" + value + "': " + long_name;
         const std::string refused = cannot_make_entries(existing);
         if (refused.empty()) return {};
         return "cannot create the output folder '" + value + "': no folder can be made in '" +

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -20,10 +21,7 @@ void write_atomically(const std::string& final_path, const std::function<void(co
   if (!fs::is_directory(dir))
     throw InputError("cannot write '" + final_path + "': directory '" + dir.string() +
                      "' does not exist; create it first");
-  // The temporary keeps the final extension: some writers (VTK) choose the format from it.
-  const std::string tmp = (dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) +
-                                  target.extension().string()))
-                              .string();
+  const std::string tmp = temporary_path_beside(final_path, target.extension().string());
   try {
     write(tmp);
   } catch (...) {
@@ -38,6 +36,19 @@ void write_atomically(const std::string& final_path, const std::function<void(co
     fs::remove(tmp, ignored);
     throw RunError("cannot write '" + final_path + "': " + ec.message());
   }
+}
+
+std::string temporary_path_beside(const std::string& final_path, const std::string& extension) {
+  const fs::path target(final_path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string name = target.filename().string();
+  std::string stem = name.substr(0, name.size() - std::min(name.size(), extension.size()));
+  const std::string tag = ".tmp" + std::to_string(::getpid());
+  const long limit = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  const std::size_t most = limit > 0 ? static_cast<std::size_t>(limit) : 255;
+  const std::size_t added = 1 + tag.size() + extension.size();
+  if (stem.size() + added > most) stem.resize(most > added ? most - added : 0);
+  return (dir / ("." + stem + tag + extension)).string();
 }
 
 void write_file_atomically(const std::string& final_path, const std::string& contents) {

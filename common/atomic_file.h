@@ -10,6 +10,12 @@ namespace hexbite {
 // when write returns; removes the temporary file if write throws. The directory must exist.
 void write_atomically(const std::string& final_path, const std::function<void(const std::string&)>& write);
 
+// The temporary name beside `final_path` that its content is written to first: hidden, with the process id,
+// ending in `extension` (the format's, ".vtu" or ".nii.gz": some writers choose the format from it). The
+// final name's stem is shortened when the temporary name would be longer than the folder's file system
+// allows (a 250-byte name is a valid output; its temporary name with ".tmpPID" added was not).
+std::string temporary_path_beside(const std::string& final_path, const std::string& extension);
+
 // Convenience: writes a whole text or binary string atomically.
 void write_file_atomically(const std::string& final_path, const std::string& contents);
 

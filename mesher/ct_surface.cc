@@ -1,6 +1,5 @@
 #include "mesher/ct_surface.h"
 
-#include <unistd.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
@@ -31,6 +30,7 @@
 #include <sstream>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/number_format.h"
 #include "common/paths.h"
@@ -416,7 +416,7 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
   // the format and the compression.
   const std::string base = target.filename().string();
   const std::string stem = base.substr(0, base.size() - fmt.extension.size());
-  const fs::path tmp = dir / ("." + stem + ".tmp" + std::to_string(::getpid()) + fmt.extension);
+  const fs::path tmp = temporary_path_beside(path, fmt.extension);
   // A .mhd header refers to a separate data file, written straight to its final name beside it.
   const fs::path raw = dir / (stem + ".zraw");
 

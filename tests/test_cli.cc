@@ -329,6 +329,13 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
       {{"run", "scenario.yaml", "-o", "/proc/hexbite-out"},
        "cannot create the output folder '/proc/hexbite-out': no folder can be made in '/proc'"},
       {{"study", "study.yaml", "-o", "/proc/hexbite-out/study"}, "give a folder you can write to"},
+      // Names longer than the file system allows (255 bytes) were found only when the outputs were
+      // written, after the work (exit 1, "File name too long").
+      {{"mesh", cube, "-o", dir + "/" + std::string(300, 'm') + ".vtu"},
+       "a name in it is 304 bytes long, more than the 255 that its file system allows; give a shorter name"},
+      {{"run", "scenario.yaml", "-o", dir + "/new/" + std::string(256, 'r') + "/out"},
+       "cannot create the output folder '" + dir + "/new/" + std::string(256, 'r') +
+           "/out': a name in it is 256 bytes long"},
   };
   for (const Case& c : cases) {
     const auto r = run_hexbite(c.args);
@@ -339,6 +346,12 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   EXPECT_TRUE(fs::is_empty(dir));
   // Any case of the extension is fine.
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
+  // A name of 255 bytes is written (its temporary name, the name with ".tmpPID" added, used to be too long).
+  const std::string longest = dir + "/" + std::string(251, 'c') + ".stl";
+  const auto r = run_hexbite({"surface", "check", cube, "-o", longest});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(longest));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2);
 }
 
 // An output in a folder that takes no new files (/proc, also for root) is refused when the command line is
