@@ -56,10 +56,11 @@ void write_report(const ReportArgs& a) {
   if (!a.no_pictures) {
     const std::string vtu = solution_for_pictures(a.run_dir);
     // The same refusal as `hexbite render`, before any work, with the way out that a report has.
-    if (!can_render())
-      throw RunError(
-          "cannot draw the report's pictures: no X display (DISPLAY is not set); run the command "
-          "under `xvfb-run -a`, or add --no-pictures for a report without pictures");
+    const std::string no_display = display_problem();
+    if (!no_display.empty())
+      throw RunError("cannot draw the report's pictures: no X display (" + no_display +
+                     "); run the command under `xvfb-run -a`, or add --no-pictures for a report without "
+                     "pictures");
     pictures = render_report_pictures(vtu, run);
   }
   const std::vector<std::string> warnings = report_warnings(run);

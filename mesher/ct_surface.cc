@@ -4,6 +4,7 @@
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
 #include <vtkDataArray.h>
+#include <vtkDataArrayRange.h>
 #include <vtkFloatArray.h>
 #include <vtkFlyingEdges3D.h>
 #include <vtkImageData.h>
@@ -486,6 +487,10 @@ TriSurface surface_from_volume(const VoxelVolume& volume, double threshold, CtEx
   // border of the scan, so the result always bounds a solid.
   const float background = *lo;
   auto image = to_image(volume, 1, background);
+  // So are voxels without a value: the contour through one (a NaN) had NaN coordinates.
+  auto* hu = static_cast<vtkFloatArray*>(image->GetPointData()->GetScalars());
+  for (float& x : vtk::DataArrayValueRange<1>(hu))
+    if (!std::isfinite(x)) x = background;
 
   auto contour = vtkSmartPointer<vtkFlyingEdges3D>::New();
   contour->SetInputData(image);

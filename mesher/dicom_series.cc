@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <sstream>
 
@@ -93,11 +94,21 @@ struct SeriesTags {
 bool read_slice(const std::string& file, const std::string& folder, Slice& slice, SeriesTags& tags) {
   gdcm::ImageReader reader;
   reader.SetFileName(file.c_str());
-  if (!reader.Read()) return false;
+  // GDCM reads a file cut off in its pixel data (an interrupted copy) and fills the missing pixels; it says
+  // so only as a warning, which is caught here.
+  std::ostringstream warnings;
+  gdcm::Trace::SetWarningStream(warnings);
+  gdcm::Trace::SetWarning(true);
+  const bool read = reader.Read();
+  gdcm::Trace::SetWarning(false);
+  gdcm::Trace::SetWarningStream(std::cerr);
+  if (!read) return false;
   const gdcm::Image& image = reader.GetImage();
   const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
   const std::string where =
       "DICOM series '" + folder + "': file '" + fs::path(file).filename().string() + "'";
+  if (warnings.str().find("Incomplete Pixel Data") != std::string::npos)
+    throw InputError(where + " is cut off in its pixel data (an incomplete copy?); copy the series again");
   if (image.GetNumberOfDimensions() == 3 && image.GetDimension(2) > 1)
     throw InputError(where + " holds " + std::to_string(image.GetDimension(2)) +
                      " frames (an enhanced multi-frame image), which hexbite does not read; export the "

@@ -4,8 +4,11 @@
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkDataSet.h>
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkLookupTable.h>
+#include <vtkMapper.h>
+#include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
@@ -26,19 +29,29 @@
 #include <vtkXMLReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
+#include <X11/Xlib.h>
+
+#include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/number_format.h"
 #include "common/paths.h"
 #include "mesher/vtk_messages.h"
 
 namespace hexbite {
 
-bool can_render() {
+std::string display_problem() {
   const char* display = std::getenv("DISPLAY");
-  return display != nullptr && *display != '\0';
+  if (display == nullptr || *display == '\0') return "DISPLAY is not set";
+  // A DISPLAY left over from a closed ssh session or an ended Xvfb: VTK would abort on it.
+  Display* x = XOpenDisplay(nullptr);
+  if (x == nullptr) return std::string("the X display '") + display + "' does not answer";
+  XCloseDisplay(x);
+  return {};
 }
 
 namespace {
@@ -87,14 +100,57 @@ void place_camera(vtkCamera* camera, const std::string& view) {
 
 namespace {
 
+// Where `data`'s points fall in the picture, in view coordinates ([-1, 1] across and up): {x0, x1, y0, y1}.
+std::array<double, 4> view_extent(vtkCamera* camera, vtkDataSet* data, double aspect) {
+  vtkMatrix4x4* m = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
+  std::array<double, 4> e = {1e300, -1e300, 1e300, -1e300};
+  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) {
+    double p[4] = {0, 0, 0, 1}, q[4];
+    data->GetPoint(i, p);
+    m->MultiplyPoint(p, q);
+    e[0] = std::min(e[0], q[0] / q[3]);
+    e[1] = std::max(e[1], q[0] / q[3]);
+    e[2] = std::min(e[2], q[1] / q[3]);
+    e[3] = std::max(e[3], q[1] / q[3]);
+  }
+  return e;
+}
+
+// Zooms and shifts the camera until the object's points fill the picture with a margin, left of the
+// colour legend when there is one. VTK's ResetCamera fits the bounding sphere into the vertical view
+// angle only, and the fixed zoom used before cut off tall objects, and wide ones in portrait pictures.
+void frame_object(vtkRenderer* renderer, vtkActor* actor, double aspect, bool legend) {
+  vtkCamera* camera = renderer->GetActiveCamera();
+  actor->GetMapper()->Update();
+  vtkDataSet* data = actor->GetMapper()->GetInput();
+  if (data == nullptr || data->GetNumberOfPoints() == 0) return;
+  // The legend (vtkScalarBarActor's default place) starts at 0.82 of the width: x = 0.64.
+  const double x0 = -0.94, x1 = legend ? 0.56 : 0.94, y0 = -0.9, y1 = 0.92;
+  // A zoom changes the view angle, and the perspective makes the fit not quite linear: a few rounds.
+  for (int round = 0; round < 4; ++round) {
+    renderer->ResetCameraClippingRange();
+    std::array<double, 4> e = view_extent(camera, data, aspect);
+    const double scale =
+        std::min((x1 - x0) / std::max(e[1] - e[0], 1e-12), (y1 - y0) / std::max(e[3] - e[2], 1e-12));
+    camera->Zoom(scale);
+    e = view_extent(camera, data, aspect);
+    double centre[2];
+    camera->GetWindowCenter(centre);
+    camera->SetWindowCenter(centre[0] + (e[0] + e[1]) / 2 - (x0 + x1) / 2,
+                            centre[1] + (e[2] + e[3]) / 2 - (y0 + y1) / 2);
+  }
+  renderer->ResetCameraClippingRange();
+}
+
 // Draws one actor (and optional 2-D actors) with the chosen view and writes the PNG.
 void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& png_path,
                       const RenderOptions& options) {
   vtkNew<vtkCamera> camera;
   place_camera(camera, options.view);  // validates the view before anything is opened
-  if (!can_render())
-    throw RunError("cannot render '" + png_path +
-                   "': no X display (DISPLAY is not set); run the command under `xvfb-run -a`");
+  const std::string no_display = display_problem();
+  if (!no_display.empty())
+    throw RunError("cannot render '" + png_path + "': no X display (" + no_display +
+                   "); run the command under `xvfb-run -a`");
   actor->GetProperty()->SetSpecular(0.2);
   if (options.edges) {
     actor->GetProperty()->EdgeVisibilityOn();
@@ -107,7 +163,7 @@ void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& pn
   renderer->SetBackground(1, 1, 1);
   renderer->SetActiveCamera(camera);
   renderer->ResetCamera();
-  camera->Zoom(1.3);
+  frame_object(renderer, actor, double(options.width) / options.height, legend != nullptr);
   if (!options.title.empty()) {
     vtkNew<vtkTextActor> text;
     text->SetInput(options.title.c_str());
@@ -221,7 +277,17 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
   array->GetRange(range, component);
   // Stress peaks at the edges of fixed patches would wash out the rest of the picture: let the caller
   // cap the scale (values above it show in the top colour).
-  if (options.colour_max > 0) range[1] = options.colour_max;
+  if (options.colour_max > 0) {
+    // A top below every value left VTK with an inverted table ("Bad table range") and a legend of 0 to 1.
+    if (!(options.colour_max > range[0]))
+      throw InputError("the colour scale's top, " + format_significant(options.colour_max) +
+                       ", is not above the smallest value of '" + field + "' in '" + vtu_path + "' (" +
+                       format_significant(range[0]) + "; the values range from " +
+                       format_significant(range[0]) + " to " + format_significant(range[1]) +
+                       "): every face would show in one colour; give a --max above " +
+                       format_significant(range[0]));
+    range[1] = options.colour_max;
+  }
   colours->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
   colours->SetTableRange(range);
   colours->Build();

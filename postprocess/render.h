@@ -16,9 +16,10 @@ struct RenderOptions {
   double colour_max = 0;  // upper end of the colour scale; 0 = the field's maximum
 };
 
-// True when VTK can open a window here: an X display is set. Rendering without one aborts inside
-// VTK, so callers check this first and tell the user to run under `xvfb-run -a`.
-bool can_render();
+// Why VTK cannot open a window here ("DISPLAY is not set", "the X display ':77' does not answer"), or
+// empty when it can. Rendering without a display aborts inside VTK (exit 134), so callers check this first
+// and tell the user to run under `xvfb-run -a`.
+std::string display_problem();
 
 // Renders the triangle surface and writes a PNG atomically. Throws RunError when no display.
 void render_surface_png(const TriSurface& surface, const std::string& png_path, const RenderOptions& options);

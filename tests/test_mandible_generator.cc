@@ -594,6 +594,23 @@ VoxelVolume two_blocks_one_pocket() {
   return v;
 }
 
+// Voxels without a value (NaN, infinities: outside some exporters' field of view) are background. Next to
+// the bone they gave surface points with NaN coordinates, written with exit 0.
+TEST(CtVolume, VoxelsWithoutAValueAreBackground) {
+  VoxelVolume v = two_blocks_one_pocket();
+  const TriSurface clean = surface_from_volume(v, 500.0);
+  const auto at = [&](int i, int j, int k) -> float& {
+    return v.values[(static_cast<std::size_t>(k) * 16 + j) * 30 + i];
+  };
+  at(1, 7, 7) = std::numeric_limits<float>::quiet_NaN();  // beside the big block's face at i = 2
+  at(14, 8, 8) = std::numeric_limits<float>::infinity();
+  at(7, 14, 7) = -std::numeric_limits<float>::infinity();
+  const TriSurface s = surface_from_volume(v, 500.0);
+  for (const Vec3& p : s.vertices)
+    ASSERT_TRUE(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+  EXPECT_NEAR(enclosed_volume(s), enclosed_volume(clean), 1e-9);
+}
+
 TEST(CtVolume, DroppedPiecesAndFilledCavitiesAreReported) {
   CtExtraction dropped;
   const TriSurface s = surface_from_volume(two_blocks_one_pocket(), 500.0, &dropped);

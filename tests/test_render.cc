@@ -1,5 +1,8 @@
 // `hexbite render`: pictures of surfaces and of solution fields, and a clear refusal without a display.
 #include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -77,6 +80,63 @@ TEST(Render, SurfaceAndSolutionFieldPictures) {
             0)
       << read_file(dir + "/log3");
   EXPECT_EQ(png_size(read_file(dir + "/sj.png")), std::make_pair(320, 200));
+  // A top of the colour scale below every value: refused (it gave an inverted table, VTK's coloured errors
+  // and a legend of 0 to 1, exit 0).
+  EXPECT_EQ(run_with_prefix(display_prefix(),
+                            "render '" + dir + "/jaw.vtu' --field scaled_jacobian --max 0.01 -o '" + dir +
+                                "/low.png' --width 320 --height 200",
+                            dir + "/log4"),
+            2);
+  const std::string log4 = read_file(dir + "/log4");
+  EXPECT_NE(log4.find("the colour scale's top, 0.01, is not above the smallest value of 'scaled_jacobian'"),
+            std::string::npos)
+      << log4;
+  EXPECT_EQ(log4.find("Bad table range"), std::string::npos) << log4;
+  EXPECT_FALSE(fs::exists(dir + "/low.png"));
+}
+
+// Pixels of the picture's outermost rows and columns that are not background (white).
+int object_pixels_on_the_border(const std::string& png) {
+  vtkNew<vtkPNGReader> reader;
+  reader->SetFileName(png.c_str());
+  reader->Update();
+  vtkImageData* image = reader->GetOutput();
+  int dims[3];
+  image->GetDimensions(dims);
+  int count = 0;
+  for (int y = 0; y < dims[1]; ++y)
+    for (int x = 0; x < dims[0]; ++x) {
+      if (x > 1 && x < dims[0] - 2 && y > 1 && y < dims[1] - 2) continue;
+      double white = 0;
+      for (int c = 0; c < 3; ++c) white += image->GetScalarComponentAsDouble(x, y, 0, c);
+      if (white < 3 * 255 - 30) ++count;
+    }
+  return count;
+}
+
+// The whole object is in the picture: a tall box seen from the front in a landscape picture, and the jaw in
+// a portrait one, used to run off the top and bottom, or the sides (a fixed zoom after VTK's ResetCamera).
+TEST(Render, TheWholeObjectIsInThePicture) {
+  const std::string dir = temp_dir();
+  test::write_file(dir + "/tall.obj",
+                   "v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nv 0 0 60\nv 10 0 60\nv 10 10 60\nv 0 10 60\n"
+                   "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\n"
+                   "f 3 8 7\nf 4 1 5\nf 4 5 8\n");
+  ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--voxel", "1.5"}).exit_code,
+            0);
+  struct Case {
+    std::string input, options;
+  };
+  for (const Case& c : {Case{"tall.obj", "--view front"}, Case{"tall.obj", "--view iso"},
+                        Case{"jaw.stl", "--view front --width 300 --height 600"},
+                        Case{"jaw.stl", "--view top --width 300 --height 600"}}) {
+    ASSERT_EQ(run_with_prefix(display_prefix(),
+                              "render '" + dir + "/" + c.input + "' -o '" + dir + "/p.png' " + c.options,
+                              dir + "/log"),
+              0)
+        << read_file(dir + "/log");
+    EXPECT_EQ(object_pixels_on_the_border(dir + "/p.png"), 0) << c.input << " " << c.options;
+  }
 }
 
 // A cut-off VTU: one error line with VTK's explanation in it, not VTK's own coloured multi-line log.
@@ -184,6 +244,16 @@ TEST(Render, WithoutDisplayFailsClearlyAndWritesNothing) {
   EXPECT_EQ(code, 1);
   EXPECT_NE(read_file(dir + "/log").find("no X display"), std::string::npos) << read_file(dir + "/log");
   EXPECT_NE(read_file(dir + "/log").find("xvfb-run -a"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir + "/jaw.png"));
+  // A DISPLAY whose X server is gone (a closed ssh session): VTK aborted (exit 134).
+  EXPECT_EQ(run_with_prefix("env DISPLAY=:1999", "render '" + dir + "/jaw.stl' -o '" + dir + "/jaw.png'",
+                            dir + "/log"),
+            1);
+  EXPECT_NE(read_file(dir + "/log")
+                .find("no X display (the X display ':1999' does not answer); run the "
+                      "command under `xvfb-run -a`"),
+            std::string::npos)
+      << read_file(dir + "/log");
   EXPECT_FALSE(fs::exists(dir + "/jaw.png"));
 }
 
