@@ -248,7 +248,7 @@ void add_refine_command(CLI::App& app) {
                 "After the refinement, move the new boundary nodes off the --surface until the boundary "
                 "quads straddle it (for a mesh made with hexbite mesh --fit-volume; the input's nodes stay)");
   cmd->add_option("--levels", o->levels, "Number of refinement levels (each multiplies the hexes by 8)")
-      ->check(CLI::Range(1, 4))
+      ->transform(count_in_range(1, 4))
       ->default_val(1);
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the tables");
   cmd->callback([o] { run_refine(*o); });

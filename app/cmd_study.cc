@@ -176,7 +176,7 @@ void add_study_command(CLI::App& app) {
   cmd->add_option("--levels", o->levels,
                   "Validation levels of every variant (each refines the mesh 8-way and solves again); "
                   "overrides the scenarios' mesh.validation_levels")
-      ->check(CLI::Range(0, 3));
+      ->transform(count_in_range(0, 3));
   cmd->add_flag("--json", o->json, "Print study.json instead of the table");
   cmd->callback([o] { run_study(*o); });
 }

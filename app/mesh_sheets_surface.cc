@@ -11,6 +11,7 @@
 
 #include "app/mesh_inputs.h"
 #include "app/mesh_sheets.h"
+#include "app/option_checks.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "mesher/cycle_elimination.h"
@@ -186,7 +187,7 @@ void add_refine_options(CLI::App& cmd, RefineCommandOptions& o) {
       ->needs(at);
   cmd.add_option("--refine-levels", o.levels,
                  "Rings of quads added around the patch; each makes the quads inside it smaller")
-      ->check(CLI::Range(1, kMaxRefineLevels))
+      ->transform(count_in_range(1, kMaxRefineLevels))
       ->capture_default_str()
       ->needs(at);
 }

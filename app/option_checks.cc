@@ -46,7 +46,9 @@ std::string out_of_range(const std::string& value, double lo, double hi, const s
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != value.size()) return value + " is not a number: " + give;
+  // std::stod reads hexadecimal too ("0x1"), which a count or a length written by a user never is.
+  if (used == 0 || used != value.size() || value.find_first_of("xX") != std::string::npos)
+    return value + " is not a number: " + give;
   if (!std::isfinite(*number) || *number < lo || *number > hi) return value + " is out of range: " + give;
   return {};
 }

@@ -383,6 +383,34 @@ TEST(CliBadInput, AnOutputThatCannotBeCreatedIsNamed) {
   }
 }
 
+// Level counts are counts like --target-hexes: `--levels 1.0` was "not in range 0 to 3", an empty value too,
+// and `--levels 0x1` ran one level. Hexadecimal is refused for every count.
+TEST(CliBadInput, LevelCountsAreWholeDecimalNumbers) {
+  const std::string dir = temp_dir();
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"run", "s.yaml", "-o", dir + "/o", "--levels", "0x1"},
+       "--levels: 0x1 is not a number: give a whole number from 0 to 3"},
+      {{"run", "s.yaml", "-o", dir + "/o", "--levels", ""},
+       "is not a number: give a whole number from 0 to 3"},
+      {{"run", "s.yaml", "-o", dir + "/o", "--levels", "4"},
+       "--levels: 4 is out of range: give a whole number from 0 to 3"},
+      {{"study", "s.yaml", "-o", dir + "/o", "--levels", "1.5"}, "--levels: 1.5 is not a whole number"},
+      {{"refine", "m.vtu", "-o", dir + "/f.vtu", "--levels", "9"},
+       "--levels: 9 is out of range: give a whole number from 1 to 4"},
+      {{"mesh", "m.stl", "-o", dir + "/m.vtu", "--target-hexes", "0x1000"}, "0x1000 is not a number"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 // Not-a-number and infinite values of real-valued options are input errors (exit 2) that give the range, and
 // nothing is written: `mesh --margin nan` crashed (segmentation fault; CLI::Range lets NaN through) and
 // `--refine-at nan,0,0` stopped on a floating-point exception.

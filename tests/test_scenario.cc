@@ -400,6 +400,18 @@ TEST(ScenarioErrors, MissingRequiredFields) {
                   "has no 'geometry'");
 }
 
+// Whole numbers are decimal, as YAML 1.2 reads them: `target_hexes: 04000` was read as octal (2048 hexes,
+// exit 0), and `2e3` was "not a whole number".
+TEST(Scenario, WholeNumbersAreDecimalAndMayBeWrittenInScientificNotation) {
+  for (const auto& [text, hexes] : std::vector<std::pair<std::string, int>>{
+           {"04000", 4000}, {"2e3", 2000}, {"2.0e3", 2000}, {"+3000", 3000}, {"3000.0", 3000}}) {
+    const Scenario s = load_scenario(write_scenario(kValid + "mesh: {target_hexes: " + text + "}\n"));
+    EXPECT_EQ(s.mesh.target_hexes, hexes) << text;
+  }
+  EXPECT_EQ(load_scenario(write_scenario(kValid + "mesh: {validation_levels: 02}\n")).mesh.validation_levels,
+            2);
+}
+
 TEST(ScenarioErrors, IllTypedFields) {
   EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: high")), 6,
                   "muscles[0].activation must be a number, found 'high'");
@@ -412,6 +424,10 @@ TEST(ScenarioErrors, IllTypedFields) {
                   "must be a number, found the quoted text \"0.5\"");
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 2.5}\n"), 11,
                   "mesh.target_hexes must be a whole number");
+  // Hexadecimal and octal are refused; a whole number in scientific notation is not "not whole".
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 0x1000}\n"), 11,
+                  "mesh.target_hexes must be a whole number, found '0x1000'; write it in decimal digits");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 0o7640}\n"), 11, "write it in decimal digits");
   EXPECT_ERROR_AT(error_of(kValid + "outputs: {vtu: maybe}\n"), 11, "outputs.vtu must be true or false");
   EXPECT_ERROR_AT(error_of(kValid + "probes: {name: x}\n"), 11, "probes must be a list");
   EXPECT_ERROR_AT(error_of(replace(kValid, "at: right_condyle_tmj_point", "at: [1, 2]")), 9,
