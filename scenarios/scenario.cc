@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <regex>
 #include <tuple>
 #include <utility>
 
@@ -85,22 +84,10 @@ double to_number(const Value& v) {
   return x;
 }
 
-// Whole numbers are read in decimal as YAML 1.2 reads them: "04000" is 4000 (yaml-cpp read it as octal,
-// 2048, without a word), and "2e3" or "4000.0" are whole numbers too. Hexadecimal and octal ("0x10", "0o10")
-// are refused: nobody writes a mesh size that way on purpose.
 int to_int(const Value& v) {
-  const std::string text = v.node.IsScalar() ? v.node.Scalar() : std::string();
-  double x = 0;
-  bool whole = false;
-  if (v.node.IsScalar() && !is_quoted(v.node) && text.find_first_of("xXoO") == std::string::npos) {
-    if (std::regex_match(text, std::regex("[-+]?[0-9]+"))) {
-      whole = true;
-      x = std::stod(text);  // decimal, leading zeros and all
-    } else {
-      whole = YAML::convert<double>::decode(v.node, x) && std::isfinite(x) && x == std::floor(x);
-    }
-  }
-  if (!whole || x < std::numeric_limits<int>::min() || x > std::numeric_limits<int>::max())
+  long long x = 0;
+  if (!decimal_whole_number(v.node, &x) || x < std::numeric_limits<int>::min() ||
+      x > std::numeric_limits<int>::max())
     fail(v.at, v.path + " must be a whole number, found " + describe(v.node) +
                    "; write it in decimal digits, without quotes");
   return static_cast<int>(x);

@@ -48,7 +48,8 @@ json to_json(const YAML::Node& node) {
   long long integer = 0;
   double number = 0;
   bool flag = false;
-  if (YAML::convert<long long>::decode(node, integer)) return integer;
+  if (decimal_whole_number(node, &integer) && node.Scalar().find_first_of(".eE") == std::string::npos)
+    return integer;
   if (YAML::convert<double>::decode(node, number) && std::isfinite(number)) return number;
   if (YAML::convert<bool>::decode(node, flag)) return flag;
   return node.Scalar();

@@ -1,9 +1,11 @@
 #include "scenarios/yaml_input.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <sstream>
 #include <utility>
 
@@ -74,6 +76,20 @@ std::string suggestion(const std::string& given, const std::vector<std::string>&
 
 bool is_quoted(const YAML::Node& node) {
   return node.IsScalar() && (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str");
+}
+
+bool decimal_whole_number(const YAML::Node& node, long long* value) {
+  if (!node.IsScalar() || is_quoted(node)) return false;
+  const std::string& text = node.Scalar();
+  if (text.find_first_of("xXoO") != std::string::npos) return false;
+  double x = 0;
+  if (std::regex_match(text, std::regex("[-+]?[0-9]+")))
+    x = std::stod(text);  // decimal, leading zeros and all
+  else if (!YAML::convert<double>::decode(node, x) || !std::isfinite(x) || x != std::floor(x))
+    return false;
+  if (std::abs(x) > 9007199254740992.0) return false;  // 2^53: beyond it a double holds no exact integer
+  *value = static_cast<long long>(x);
+  return true;
 }
 
 std::string describe(const YAML::Node& node) {

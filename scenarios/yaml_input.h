@@ -70,6 +70,12 @@ bool is_quoted(const YAML::Node& node);
 // "nothing", "a list", "a mapping", "the quoted text ..." or the scalar quoted: for "found ..." messages.
 std::string describe(const YAML::Node& node);
 
+// A whole number as YAML 1.2 reads it, in decimal: "04000" is 4000 (yaml-cpp's own conversion reads it as
+// octal, 2048, without a word), and "2e3" or "4000.0" are whole numbers too. Hexadecimal and octal
+// ("0x10", "0o10") are not: nobody writes a mesh size that way on purpose. False for anything else
+// (quoted text, fractions, lists, numbers beyond +-2^53).
+bool decimal_whole_number(const YAML::Node& node, long long* value);
+
 std::string to_string(const Value& v);       // non-empty text
 std::vector<Value> to_list(const Value& v);  // a list (null reads as an empty one)
 

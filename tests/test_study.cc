@@ -287,6 +287,17 @@ TEST(Study, PlacesAndRelativePathsFollowTheFileTheyWereWrittenIn) {
       << error;
 }
 
+// A whole number the study set is decimal in the variant and in the tables' record of the change: the
+// variant meshed 1,024 hexes for `target_hexes: 02000` (octal) and study.json said so.
+TEST(Study, WholeNumbersTheStudySetAreDecimal) {
+  std::string text = kStudy;
+  text.replace(text.find("materials.default.E_MPa: 5500"), 29, "mesh.target_hexes: 02000");
+  const Study study = load_study(study_folder(text) + "/study.yaml");
+  ASSERT_EQ(study.variants.size(), 3u);
+  EXPECT_EQ(study.variants[1].scenario.mesh.target_hexes, 2000);
+  EXPECT_EQ(study.variants[1].set.at("mesh.target_hexes"), 2000);
+}
+
 // All or nothing: a variant whose displacements are absurd (a modulus in the wrong unit) fails the study
 // after the others solved, and the folder keeps the earlier study's files byte for byte.
 TEST(Study, AFailedVariantLeavesTheOutputFolderAsItWas) {
