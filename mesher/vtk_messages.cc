@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <new>
 
 #include "common/error.h"
@@ -42,6 +44,43 @@ void disable_string_arrays(vtkXMLDataElement* e, vtkXMLReader* reader) {
         selection->DisableArray(array_name);
     }
   }
+}
+
+// Whether a <Piece> below e has a <CellData> but no <PointData> element, and the name of its first data
+// array without a Name attribute (in `unnamed`, as "CellData of piece 0"), if any.
+bool cell_data_without_point_data(vtkXMLDataElement* e, std::string* unnamed, int* piece) {
+  bool found = false;
+  for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
+    vtkXMLDataElement* child = e->GetNestedElement(i);
+    const char* name = child->GetName();
+    if (name == nullptr) continue;
+    if (std::strcmp(name, "Piece") != 0) {
+      found = cell_data_without_point_data(child, unnamed, piece) || found;
+      continue;
+    }
+    const bool cells = child->FindNestedElementWithName("CellData") != nullptr;
+    found = (cells && child->FindNestedElementWithName("PointData") == nullptr) || found;
+    for (const char* data : {"PointData", "CellData"})
+      if (vtkXMLDataElement* arrays = child->FindNestedElementWithName(data))
+        for (int k = 0; k < arrays->GetNumberOfNestedElements() && unnamed->empty(); ++k)
+          if (arrays->GetNestedElement(k)->GetAttribute("Name") == nullptr)
+            *unnamed = std::string("<") + data + "> of piece " + std::to_string(*piece);
+    ++*piece;
+  }
+  return found;
+}
+
+// The file's text with an empty <PointData> before each <CellData> of its XML part (offsets into an
+// appended data section count from that section's start, so they stay right).
+std::string with_point_data(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t appended = text.find("<AppendedData");
+  for (std::size_t at = text.find("<CellData"); at != std::string::npos && at < appended;
+       at = text.find("<CellData", at + 30)) {
+    text.insert(at, "<PointData></PointData>");
+  }
+  return text;
 }
 
 // VTK's text is "ERROR: In file.cxx, line N\nvtkClass (0x...): explanation\n\n"; keeps the explanation.
@@ -105,8 +144,24 @@ void update_xml_reader(vtkXMLReader* reader, const std::string& file) {
   try {
     reader->UpdateInformation();
     vtkXMLDataParser* parser = reader->GetXMLParser();
-    if (vtkXMLDataElement* root = parser != nullptr ? parser->GetRootElement() : nullptr)
-      disable_string_arrays(root, reader);
+    vtkXMLDataElement* root = parser != nullptr ? parser->GetRootElement() : nullptr;
+    std::string unnamed;
+    int pieces = 0;
+    // VTK 9.1 dereferences the missing <PointData> element when a cell data array of a piece without one
+    // is too short (a segmentation fault in vtkXMLDataReader::ReadPieceData): such a file is read with an
+    // empty <PointData> added, and the short array is then reported like any other.
+    if (root != nullptr && cell_data_without_point_data(root, &unnamed, &pieces) && reader->GetFileName()) {
+      reader->ReadFromInputStringOn();
+      reader->SetInputString(with_point_data(file));
+      reader->UpdateInformation();
+      parser = reader->GetXMLParser();
+      root = parser != nullptr ? parser->GetRootElement() : nullptr;
+    }
+    // VTK reads a file with an unnamed array as if it held no cells at all.
+    if (!unnamed.empty())
+      throw InputError("cannot read '" + file + "': a data array in its " + unnamed +
+                       " has no Name attribute; the file is damaged, or its writer left the name out");
+    if (root != nullptr) disable_string_arrays(root, reader);
     reader->Update();
   } catch (const std::bad_alloc&) {
     // VTK allocates what the header announces before it reads the data.

@@ -151,6 +151,36 @@ TEST(HexMeshIo, VtuReaderErrors) {
   msg = test::message_of<InputError>([&] { read_vtu(dir + "/truncated.vtu"); });
   EXPECT_NE(msg.find("truncated.vtu"), std::string::npos) << msg;
   EXPECT_NE(msg.find("damaged or truncated"), std::string::npos) << msg;
+
+  // A cell data array too short for the cells, in a piece without <PointData> (as meshio writes a mesh with
+  // cell data only): VTK 9.1 ended in a segmentation fault. The same array of the right length reads.
+  const std::string piece =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt32\">\n<UnstructuredGrid><Piece NumberOfPoints=\"8\" "
+      "NumberOfCells=\"1\">\n<CellData>ARRAY</CellData>\n<Points><DataArray type=\"Float64\" "
+      "NumberOfComponents=\"3\" format=\"ascii\">" +
+      std::string(kCubePoints) +
+      "</DataArray></Points>\n<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 "
+      "3 4 5 6 7</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">8</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">12</DataArray></Cells>\n"
+      "</Piece></UnstructuredGrid></VTKFile>\n";
+  const auto with_array = [&](const std::string& array) {
+    std::string text = piece;
+    return text.replace(text.find("ARRAY"), 5, array);
+  };
+  write_file(dir + "/short.vtu", with_array("<DataArray type=\"Float64\" Name=\"region\" format=\"ascii\">"
+                                            "</DataArray>"));
+  msg = test::message_of<InputError>([&] { read_vtu(dir + "/short.vtu"); });
+  EXPECT_NE(msg.find("damaged or truncated"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("cell data array \"region\""), std::string::npos) << msg;
+  write_file(dir + "/cells_only.vtu",
+             with_array("<DataArray type=\"Float64\" Name=\"region\" format=\"ascii\">7</DataArray>"));
+  EXPECT_EQ(read_vtu(dir + "/cells_only.vtu").hexes.size(), 1u);
+  // An array without a name: VTK read no cells at all ("holds no hexahedra").
+  write_file(dir + "/unnamed.vtu", with_array("<DataArray type=\"Float64\" format=\"ascii\">7</DataArray>"));
+  msg = test::message_of<InputError>([&] { read_vtu(dir + "/unnamed.vtu"); });
+  EXPECT_NE(msg.find("a data array in its <CellData> of piece 0 has no Name attribute"), std::string::npos)
+      << msg;
 }
 
 // Before, a file without hexahedra read as an empty mesh (quality printed n/a, refine wrote an empty mesh,

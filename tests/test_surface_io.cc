@@ -307,6 +307,21 @@ TEST(SurfaceIoErrors, EmptyFile) {
   expect_input_error([&] { read_surface(path); }, {path, "is empty"});
 }
 
+// A VTP whose cell data array is too short, without <PointData> (VTK 9.1: a segmentation fault).
+TEST(SurfaceIoErrors, VtpWithAShortCellDataArray) {
+  const std::string path = temp_dir() + "/short.vtp";
+  write_file(
+      path,
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
+      "<PolyData><Piece NumberOfPoints=\"4\" NumberOfPolys=\"4\">\n<CellData><DataArray type=\"Float64\" "
+      "Name=\"a\" format=\"ascii\">1</DataArray></CellData>\n<Points><DataArray type=\"Float64\" "
+      "NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points>\n<Polys>"
+      "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 2 1 0 1 3 1 2 3 0 3 2</DataArray>\n"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">3 6 9 12</DataArray></Polys>\n"
+      "</Piece></PolyData></VTKFile>\n");
+  expect_input_error([&] { read_surface(path); }, {path, "Cannot read cell data array \"a\""});
+}
+
 TEST(SurfaceIoErrors, UnknownExtension) {
   const std::string path = temp_dir() + "/cube.xyz";
   write_file(path, kCubeVertices);
