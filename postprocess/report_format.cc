@@ -39,9 +39,10 @@ std::string format_percent(std::optional<double> fraction) {
 }
 
 std::string format_point(const Vec3& p, int decimals) {
-  char text[192];
-  std::snprintf(text, sizeof text, "(%.*f, %.*f, %.*f)", decimals, p[0], decimals, p[1], decimals, p[2]);
-  return text;
+  // Each component as the tables write numbers: a small one that is not zero in scientific notation (the
+  // force of a muscle at 1e-4 activation read "(-0.0, -0.0, 0.0)").
+  return "(" + format_table_number(p[0], decimals, 0) + ", " + format_table_number(p[1], decimals, 0) + ", " +
+         format_table_number(p[2], decimals, 0) + ")";
 }
 
 std::string format_count(long n) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common/number_format.h"
 #include "mesher/vec3.h"
 #include "postprocess/html.h"
 #include "postprocess/report_format.h"
@@ -72,11 +73,8 @@ std::pair<std::string, bool> num(const std::string& html) {
   return {html, true};
 }
 
-std::string stat(const std::optional<double>& v, const char* format) {
-  if (!v) return "n/a";
-  char text[64];
-  std::snprintf(text, sizeof text, format, *v);
-  return text;
+std::string stat(const std::optional<double>& v, int decimals) {
+  return v ? format_table_number(*v, decimals, 0) : "n/a";
 }
 
 void what_was_run(std::ostringstream& out, const RunFigures& r, const ReportOptions& o) {
@@ -143,8 +141,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
     t.header({text("muscle"), num("activation"), num("force (N)"), text("direction"),
               num("patch (mm<sup>2</sup>)")});
     for (const MuscleFigures& m : r.muscles) {
-      char activation[32];
-      std::snprintf(activation, sizeof activation, "%.2f", m.activation.value_or(0));
+      const std::string activation = format_table_number(m.activation.value_or(0), 2, 0);
       const Vec3 unit = m.magnitude > 0 ? vec3::scale(m.force, 1.0 / m.magnitude) : m.force;
       t.row({text(html_escape(m.name)), num(m.activation ? activation : "n/a"),
              num(format_newtons(m.magnitude)), text(format_point(unit, 2)),
@@ -250,13 +247,14 @@ void quality_section(std::ostringstream& out, const RunFigures& r) {
   {
     Table t(out);
     t.header({text("quality measure"), num("min"), num("average"), num("max")});
-    const auto row = [&](const char* name, const QualityFigures& q, const char* format) {
-      t.row({text(name), num(stat(q.min, format)), num(stat(q.mean, format)), num(stat(q.max, format))});
+    const auto row = [&](const char* name, const QualityFigures& q, int decimals) {
+      t.row(
+          {text(name), num(stat(q.min, decimals)), num(stat(q.mean, decimals)), num(stat(q.max, decimals))});
     };
-    row("scaled Jacobian", r.scaled_jacobian, "%.3f");
-    row("condition number (cube = 3)", r.condition, "%.2f");
-    row("condition number (Verdict, cube = 1)", r.condition_verdict, "%.2f");
-    row("Oddy", r.oddy, "%.2f");
+    row("scaled Jacobian", r.scaled_jacobian, 3);
+    row("condition number (cube = 3)", r.condition, 2);
+    row("condition number (Verdict, cube = 1)", r.condition_verdict, 2);
+    row("Oddy", r.oddy, 2);
   }
   out << "<p>Inverted elements: " << r.inverted << ".</p>\n";
   if (!r.fidelity) return;
@@ -308,8 +306,7 @@ void solver_section(std::ostringstream& out, const RunFigures& r) {
   t.header(
       {num("level"), num("dofs"), text("linear solver"), num("iterations"), num("seconds"), num("ranks")});
   for (const LevelFigures& l : r.levels) {
-    char seconds[32];
-    std::snprintf(seconds, sizeof seconds, "%.2f", l.solve_seconds);
+    const std::string seconds = format_table_number(l.solve_seconds, 2, 0);
     t.row({num(std::to_string(l.level)), num(format_count(l.dofs)),
            text(l.iterations == 0 ? "direct (MUMPS)" : "CG with algebraic multigrid (Trilinos ML)"),
            num(std::to_string(l.iterations)), num(seconds), num(std::to_string(l.ranks))});

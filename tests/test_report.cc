@@ -293,6 +293,24 @@ TEST(ReportModel, StatesTheMaterialsTheLoadsAndTheSupports) {
   EXPECT_NE(section(html, "What was run").find("run with hexbite "), std::string::npos);
 }
 
+// A figure that is not zero is never shown as zero (reports.md): an activation of 0.004 read "0.00", and a
+// direction component of 1e-4 "0.00".
+TEST(ReportModel, SmallFiguresAreNotShownAsZero) {
+  std::string scenario = cube_without_levels_and_supports() +
+                         "supports:\n  - {name: nut, at: [0, 10, 10], radius_mm: 5, bite: true}\n";
+  scenario.replace(scenario.find("activation: 1,"), 14, "activation: 0.004,");
+  scenario.replace(scenario.find("direction: [1, 0, 0]"), 20, "direction: [1, 0.0001, 0]");
+  const std::string run = run_cube(scenario);
+  const std::string out = temp_dir() + "/small.html";
+  const test::CommandResult c = run_hexbite({"-q", "report", run, "-o", out, "--no-pictures"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const std::string model = section(read_file(out), "Model");
+  EXPECT_NE(model.find("<td>pull</td><td class=\"n\">4.00e-03</td><td class=\"n\">0.4</td><td>(1.00, "
+                       "1.00e-04, 0.00)</td>"),
+            std::string::npos)
+      << model;
+}
+
 TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   const std::string dir = temp_dir(), out = dir + "/r.html";
   const std::string results = read_file(*run_dir_ + "/results.json");
