@@ -243,7 +243,8 @@ void add_refine_command(CLI::App& app) {
                   "Refined mesh: .vtu (with per-hex quality arrays), .inp (Abaqus / CalculiX) or .msh (Gmsh)")
       ->required()
       ->check(output_hex_mesh_file());
-  cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
+  CLI::Option* units = cmd->add_option("--units", o->units, "Length unit of the --surface file: mm, cm or m")
+                           ->default_val("mm");
   cmd->add_flag("--fit-volume", o->fit_volume,
                 "After the refinement, move the new boundary nodes off the --surface until the boundary "
                 "quads straddle it (for a mesh made with hexbite mesh --fit-volume; the input's nodes stay)");
@@ -251,7 +252,14 @@ void add_refine_command(CLI::App& app) {
       ->transform(count_in_range(1, 4))
       ->default_val(1);
   cmd->add_flag("--json", o->json, "Print one JSON object instead of the tables");
-  cmd->callback([o] { run_refine(*o); });
+  cmd->callback([o, units] {
+    // The mesh is read in mm whatever --units says: without a surface it would be silently ignored.
+    if (units->count() > 0 && o->surface.empty())
+      throw InputError(
+          "--units is the unit of the --surface file and the mesh is read in mm: give --surface, "
+          "or leave --units out");
+    run_refine(*o);
+  });
 }
 
 }  // namespace hexbite

@@ -176,6 +176,15 @@ TEST(MeshCommand, FitVolumeInMeshAndRefineButNotForAQuadSurface) {
   EXPECT_EQ(no_surface.exit_code, 2);
   EXPECT_NE(no_surface.err.find("give --surface"), std::string::npos) << no_surface.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/g.vtu"));
+  // --units without --surface was ignored, even `--units inch` (exit 0, the mesh not scaled).
+  for (const char* unit : {"m", "inch"}) {
+    const auto units = test::run_hexbite({"refine", dir + "/m.vtu", "--units", unit, "-o", dir + "/g.vtu"});
+    EXPECT_EQ(units.exit_code, 2) << unit;
+    EXPECT_NE(units.err.find("--units is the unit of the --surface file and the mesh is read in mm"),
+              std::string::npos)
+        << units.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/g.vtu"));
+  }
 
   const auto plain = test::run_hexbite({"mesh", dir + "/mandible.stl", "--method", "grid", "--target-hexes",
                                         "800", "-o", dir + "/p.vtu", "--json"});
