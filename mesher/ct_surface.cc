@@ -23,11 +23,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -224,6 +226,65 @@ vtkSmartPointer<vtkMatrix4x4> metaimage_orientation(const std::string& path) {
   return matrix;
 }
 
+// Bytes of voxel data beyond what the header of the MetaImage `path` announces (DimSize times the element
+// size), for uncompressed data in the file itself (LOCAL) or in one data file; 0 when it holds no more, or
+// when that cannot be told (compressed data, a list of files, an explicit HeaderSize, an unknown type).
+// MetaIO reads as much as announced and ignores the rest: a wrong DimSize (a slice count too small) cut the
+// bone without a word.
+std::uintmax_t metaimage_extra_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line, data_file, type;
+  std::uintmax_t voxels = 1, channels = 1;
+  bool compressed = false, known = false;
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    std::string key = line.substr(0, eq);
+    key.erase(std::remove_if(key.begin(), key.end(), [](unsigned char c) { return std::isspace(c); }),
+              key.end());
+    std::istringstream values(line.substr(eq + 1));
+    if (key == "DimSize") {
+      voxels = 1;
+      for (long d = 0; values >> d;) voxels *= static_cast<std::uintmax_t>(std::max(d, 0L));
+    } else if (key == "ElementNumberOfChannels") {
+      values >> channels;
+    } else if (key == "ElementType") {
+      values >> type;
+    } else if (key == "CompressedData") {
+      std::string yes;
+      values >> yes;
+      compressed = yes == "True" || yes == "true";
+    } else if (key == "HeaderSize") {
+      return 0;
+    } else if (key == "ElementDataFile") {
+      values >> data_file;
+      known = true;
+      break;
+    }
+  }
+  const std::map<std::string, std::uintmax_t> sizes = {{"MET_UCHAR", 1}, {"MET_CHAR", 1},  {"MET_USHORT", 2},
+                                                       {"MET_SHORT", 2}, {"MET_UINT", 4},  {"MET_INT", 4},
+                                                       {"MET_FLOAT", 4}, {"MET_DOUBLE", 8}};
+  const auto size = sizes.find(type);
+  if (!known || compressed || size == sizes.end() || data_file == "LIST" ||
+      data_file.find('%') != std::string::npos)
+    return 0;
+  const std::uintmax_t announced = voxels * channels * size->second;
+  std::error_code ec;
+  std::uintmax_t held = 0;
+  if (data_file == "LOCAL") {
+    const std::streamoff header = in.tellg();
+    const std::uintmax_t total = fs::file_size(path, ec);
+    if (ec || header < 0 || total < static_cast<std::uintmax_t>(header)) return 0;
+    held = total - static_cast<std::uintmax_t>(header);
+  } else {
+    const fs::path raw = fs::path(path).parent_path() / data_file;
+    held = fs::file_size(raw, ec);
+    if (ec) return 0;
+  }
+  return held > announced ? held - announced : 0;
+}
+
 // Turns an axis-aligned placement `m` (possibly with reversed axes) of the voxels' index grid, from the
 // index origin `org`, into a plain origin, flipping the reversed axes; a rotated grid would need
 // resampling, which is the job of a dedicated imaging tool. `what` names the input in messages.
@@ -329,6 +390,10 @@ VoxelVolume read_volume(const std::string& path, VolumeInfo* info, const std::st
       throw InputError("volume '" + path +
                        "' is cut off: it holds less voxel data than its header announces" + metaio.reason() +
                        "; export or download it again");
+    if (const std::uintmax_t extra = metaimage_extra_bytes(path))
+      throw InputError("volume '" + path + "' holds " + std::to_string(extra) +
+                       " bytes of voxel data more than its header announces (DimSize, ElementType); "
+                       "correct the header, or export the volume again");
     image = reader->GetOutput();
     orientation = metaimage_orientation(path);
   } else {

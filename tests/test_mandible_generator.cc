@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -497,6 +498,34 @@ void replace_once(std::string& s, const std::string& from, const std::string& to
   const auto at = s.find(from);
   ASSERT_NE(at, std::string::npos) << from;
   s.replace(at, from.size(), to);
+}
+
+// Uncompressed voxel data beyond what DimSize announces (a slice count too small in a hand-edited header):
+// MetaIO read the first slices and ignored the rest, a cut bone with exit 0. Refused, in the file itself and
+// in a separate data file; the right header reads.
+TEST(CtVolume, MetaImageWithMoreVoxelDataThanItsHeaderAnnouncesIsRefused) {
+  const std::string dir = test::temp_dir();
+  std::string voxels;
+  for (int i = 0; i < 4 * 3 * 2; ++i) {
+    const float x = float(i);
+    voxels.append(reinterpret_cast<const char*>(&x), sizeof x);
+  }
+  const auto header = [](const std::string& dims, const std::string& file) {
+    return "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+           "ElementSpacing = 1 1 1\nDimSize = " +
+           dims + "\nElementType = MET_FLOAT\nElementDataFile = " + file + "\n";
+  };
+  write_bytes(dir + "/right.mha", header("4 3 2", "LOCAL") + voxels);
+  EXPECT_EQ(read_volume(dir + "/right.mha").dims, (std::array<int, 3>{4, 3, 2}));
+  write_bytes(dir + "/extra.mha", header("4 3 1", "LOCAL") + voxels);
+  write_bytes(dir + "/extra.mhd", header("4 3 1", "extra.raw"));
+  write_bytes(dir + "/extra.raw", voxels);
+  for (const char* name : {"extra.mha", "extra.mhd"}) {
+    const std::string e = test::message_of<InputError>([&] { read_volume(dir + "/" + name); });
+    EXPECT_NE(e.find(std::string(name) + "' holds 48 bytes of voxel data more than its header announces"),
+              std::string::npos)
+        << e;
+  }
 }
 
 TEST(CtVolume, MetaImageDirectionAndNegativeSpacingAreHonouredOrRefused) {
