@@ -340,6 +340,47 @@ MeshPatch select_patch(const HexMesh& mesh, const HexBoundary& boundary, const s
   return patch;
 }
 
+constexpr double kProbeMaxOutsideMm = 5.0;
+
+// Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
+// nodes on the surface) runs up to a millimetre or two inside it, so such a point is often just outside the
+// mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
+// centre of the hex behind it, so that one hex contains it; results.json reports the requested point and
+// the distance moved. A point farther outside than kProbeMaxOutsideMm is refused at its line.
+std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Probe>& probes) {
+  std::vector<Vec3> points;
+  if (probes.empty()) return points;
+  const HexBoundary boundary = extract_boundary(mesh);
+  const SurfaceProjector mesh_boundary(fan_triangles(boundary.surface));
+  for (const Probe& probe : probes) {
+    const Vec3& p = probe.at.xyz;
+    if (mesh_boundary.inside(p)) {
+      points.push_back(p);
+      continue;
+    }
+    const SurfacePoint foot = mesh_boundary.closest(p);
+    // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
+    // away is a typo or a point of another frame, and its values would be those of an unrelated place.
+    const double outside = vec3::norm(vec3::sub(foot.point, p));
+    if (outside > kProbeMaxOutsideMm) {
+      char buf[400];
+      std::snprintf(
+          buf, sizeof buf,
+          ": probe '%s' at (%.2f, %.2f, %.2f) lies %.1f mm outside the mesh (nearest boundary point "
+          "(%.2f, %.2f, %.2f)); a probe must be in the bone or within %.0f mm of it: check its "
+          "coordinates and units",
+          probe.name.c_str(), p[0], p[1], p[2], outside, foot.point[0], foot.point[1], foot.point[2],
+          kProbeMaxOutsideMm);
+      throw InputError(probe.where.str() + buf);
+    }
+    const Vec3 centre = hex_centroid(mesh, boundary.quad_face[foot.triangle / 4][0]);
+    Vec3 moved;
+    for (int a = 0; a < 3; ++a) moved[a] = foot.point[a] + 0.01 * (centre[a] - foot.point[a]);
+    points.push_back(moved);
+  }
+  return points;
+}
+
 // Everything of a level that depends only on its mesh: quality, patches and materials.
 LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
   LevelResult r;
@@ -356,6 +397,8 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
   for (const Support& sup : s.supports)
     r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm, sup.where,
                                              "support '" + sup.name + "'"));
+  // Here, not before the solve: a probe far outside the mesh must not cost a study its earlier variants.
+  r.probe_points = probe_points_in_mesh(r.mesh, s.probes);
   r.hex_material.reserve(r.mesh.hexes.size());
   // A hex takes a region's material by its centre; a region that wins no hex changes nothing, which
   // must not pass for a simulated implant or resorption site. Checked on the coarse mesh (finer levels
@@ -578,47 +621,6 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
   return modes;
 }
 
-constexpr double kProbeMaxOutsideMm = 5.0;
-
-// Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
-// nodes on the surface) runs up to a millimetre or two inside it, so such a point is often just outside the
-// mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
-// centre of the hex behind it, so that one hex contains it; results.json reports the requested point and
-// the distance moved. A point farther outside than kProbeMaxOutsideMm is refused at its line.
-std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Probe>& probes) {
-  std::vector<Vec3> points;
-  if (probes.empty()) return points;
-  const HexBoundary boundary = extract_boundary(mesh);
-  const SurfaceProjector mesh_boundary(fan_triangles(boundary.surface));
-  for (const Probe& probe : probes) {
-    const Vec3& p = probe.at.xyz;
-    if (mesh_boundary.inside(p)) {
-      points.push_back(p);
-      continue;
-    }
-    const SurfacePoint foot = mesh_boundary.closest(p);
-    // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
-    // away is a typo or a point of another frame, and its values would be those of an unrelated place.
-    const double outside = vec3::norm(vec3::sub(foot.point, p));
-    if (outside > kProbeMaxOutsideMm) {
-      char buf[400];
-      std::snprintf(
-          buf, sizeof buf,
-          ": probe '%s' at (%.2f, %.2f, %.2f) lies %.1f mm outside the mesh (nearest boundary point "
-          "(%.2f, %.2f, %.2f)); a probe must be in the bone or within %.0f mm of it: check its "
-          "coordinates and units",
-          probe.name.c_str(), p[0], p[1], p[2], outside, foot.point[0], foot.point[1], foot.point[2],
-          kProbeMaxOutsideMm);
-      throw InputError(probe.where.str() + buf);
-    }
-    const Vec3 centre = hex_centroid(mesh, boundary.quad_face[foot.triangle / 4][0]);
-    Vec3 moved;
-    for (int a = 0; a < 3; ++a) moved[a] = foot.point[a] + 0.01 * (centre[a] - foot.point[a]);
-    points.push_back(moved);
-  }
-  return points;
-}
-
 void solve_level(const Scenario& s, LevelResult& r) {
   ElasticityProblem p;
   p.mesh = &r.mesh;
@@ -638,7 +640,7 @@ void solve_level(const Scenario& s, LevelResult& r) {
     }
     p.supports.push_back(std::move(patch));
   }
-  p.probes = probe_points_in_mesh(r.mesh, s.probes);
+  p.probes = r.probe_points;
   p.degree = s.solver.degree;
   const long long dofs = count_dofs(r.mesh, s.solver.degree);
   switch (s.solver.linear_solver) {

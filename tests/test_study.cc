@@ -247,6 +247,20 @@ TEST(Study, UnknownPointOfTheLastVariantStopsTheStudyBeforeAnySolve) {
   expect_refused(study, 14, "unknown point name 'nowhere'");
 }
 
+// A probe far outside the mesh was found only when its variant was solved, after the variants before it.
+TEST(Study, AProbeFarOutsideTheMeshStopsTheStudyBeforeAnySolve) {
+  const std::string dir =
+      study_folder(kStudy + "  - name: lost\n    set:\n      probes: [{name: far, at: [0, 0, -200]}]\n");
+  const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:14:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("probe 'far' at (0.00, 0.00, -200.00) lies"), std::string::npos) << r.err;
+  // Found while the variants are checked, before the output stage exists; after solves, the message would
+  // go on to say that the study kept none of its files.
+  EXPECT_EQ(r.err.find("kept none of its files"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 TEST(Study, UnknownKeyAndUnsafeVariantNameAreRefused) {
   expect_refused(kStudy + "varients: []\n", 12,
                  "unknown key 'varients' in the study; did you mean 'variants'?");
