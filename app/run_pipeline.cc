@@ -340,6 +340,13 @@ MeshPatch select_patch(const HexMesh& mesh, const HexBoundary& boundary, const s
   return patch;
 }
 
+// Where a patch's or a probe's point was written, for an error about the point (a patch that selects no
+// facet, a probe far outside): a study that set only the point ("supports.nut.at") wrote it in the study
+// file, not at the item in the base scenario. The item's place when the point has none of its own.
+const SourceLocation& point_place(const PointRef& point, const SourceLocation& item) {
+  return point.where.line > 0 ? point.where : item;
+}
+
 constexpr double kProbeMaxOutsideMm = 5.0;
 
 // Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
@@ -371,7 +378,7 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Pr
           "coordinates and units",
           probe.name.c_str(), p[0], p[1], p[2], outside, foot.point[0], foot.point[1], foot.point[2],
           kProbeMaxOutsideMm);
-      throw InputError(probe.where.str() + buf);
+      throw InputError(point_place(probe.at, probe.where).str() + buf);
     }
     const Vec3 centre = hex_centroid(mesh, boundary.quad_face[foot.triangle / 4][0]);
     Vec3 moved;
@@ -390,13 +397,14 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
   const HexBoundary boundary = extract_boundary(r.mesh);
   for (const Muscle& m : s.muscles) {
     if (m.activation <= 0) continue;
-    r.muscle_patches.push_back(select_patch(r.mesh, boundary, m.name, m.insertion.xyz, m.radius_mm, m.where,
+    r.muscle_patches.push_back(select_patch(r.mesh, boundary, m.name, m.insertion.xyz, m.radius_mm,
+                                            point_place(m.insertion, m.where),
                                             "the insertion patch of muscle '" + m.name + "'"));
     r.muscle_forces.push_back(muscle_force(m));
   }
   for (const Support& sup : s.supports)
-    r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm, sup.where,
-                                             "support '" + sup.name + "'"));
+    r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
+                                             point_place(sup.at, sup.where), "support '" + sup.name + "'"));
   // Here, not before the solve: a probe far outside the mesh must not cost a study its earlier variants.
   r.probe_points = probe_points_in_mesh(r.mesh, s.probes);
   r.hex_material.reserve(r.mesh.hexes.size());

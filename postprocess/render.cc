@@ -47,10 +47,11 @@ namespace hexbite {
 std::string display_problem() {
   const char* display = std::getenv("DISPLAY");
   if (display == nullptr || *display == '\0') return "DISPLAY is not set";
-  // A DISPLAY left over from a closed ssh session or an ended Xvfb: VTK would abort on it.
-  Display* x = XOpenDisplay(nullptr);
-  if (x == nullptr) return std::string("the X display '") + display + "' does not answer";
-  XCloseDisplay(x);
+  // A DISPLAY left over from a closed ssh session or an ended Xvfb: VTK would abort on it. The connection
+  // stays open for the process's life: an X server without other clients (xvfb-run's) resets when the last
+  // one leaves, and VTK's own connection, made right after, was refused now and then during that reset.
+  static Display* const probe = XOpenDisplay(nullptr);
+  if (probe == nullptr) return std::string("the X display '") + display + "' does not answer";
   return {};
 }
 

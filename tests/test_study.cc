@@ -261,6 +261,12 @@ TEST(Study, AProbeFarOutsideTheMeshStopsTheStudyBeforeAnySolve) {
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
+// A point the study set is named at its line in the study file: the patch that selects no facet was
+// named at the support's line in the base scenario, which still reads as it should.
+TEST(Study, APointTheStudySetIsNamedAtTheStudysLine) {
+  expect_refused(soft_setting("supports.base.at: [0, 10, -300]"), 7, "support 'base'");
+}
+
 TEST(Study, UnknownKeyAndUnsafeVariantNameAreRefused) {
   expect_refused(kStudy + "varients: []\n", 12,
                  "unknown key 'varients' in the study; did you mean 'variants'?");
