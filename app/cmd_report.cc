@@ -1,6 +1,7 @@
 // `hexbite report RUN_DIR -o report.html`: the validation report of a finished `hexbite run` as one
 // self-contained HTML file (postprocess/run_report.h), with pictures of the solution unless --no-pictures.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -36,6 +37,11 @@ std::string solution_for_pictures(const std::string& run_dir) {
   for (const char* name : {"solution.vtu", "solution.pvtu"}) {
     const std::string path = (fs::path(run_dir) / name).string();
     if (fs::is_regular_file(path, ec)) return path;
+    if (fs::is_directory(path, ec))
+      throw InputError("'" + path +
+                       "' is a folder, not the run's solution file, which the report's pictures " +
+                       "are drawn from: remove or rename that folder and run the scenario again, or add " +
+                       "--no-pictures");
   }
   throw InputError("'" + (fs::path(run_dir) / "solution.vtu").string() +
                    "' does not exist (nor a solution.pvtu of a run under mpirun), and the report's pictures "
@@ -51,6 +57,20 @@ void write_report(const ReportArgs& a) {
   if (!fs::is_directory(a.run_dir, ec))
     throw InputError("'" + a.run_dir + "' is a file, not a folder: give the folder of a finished run " +
                      "(`hexbite run SCENARIO -o RUN_DIR`), which holds results.json");
+  // The output folder of a study holds one run folder per variant, not a run of its own.
+  if (!fs::exists(fs::path(a.run_dir) / "results.json", ec) &&
+      fs::exists(fs::path(a.run_dir) / "study.json", ec)) {
+    std::vector<std::string> variants;
+    for (const fs::directory_entry& e : fs::directory_iterator(a.run_dir, ec))
+      if (fs::is_regular_file(e.path() / "results.json", ec))
+        variants.push_back(e.path().filename().string());
+    std::sort(variants.begin(), variants.end());
+    throw InputError(
+        "'" + a.run_dir + "' is the output folder of a study (it holds study.json), and a report " +
+        "is of one run: give the folder of one of its variants" +
+        (variants.empty() ? std::string()
+                          : ", e.g. '" + (fs::path(a.run_dir) / variants.front()).string() + "'"));
+  }
   const RunFigures run = read_run_figures((fs::path(a.run_dir) / "results.json").string());
   std::vector<ReportPicture> pictures;
   if (!a.no_pictures) {

@@ -706,6 +706,11 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
   if (!root_node.IsMap())
     fail(root_value.at, "a scenario must be a mapping of 'key: value' entries starting with 'name:', found " +
                             describe(root_node) + "; see docs/scenario-format.md");
+  if (root_node["base"] && root_node["variants"])
+    fail(root_value.at,
+         "this is a study file (it has 'base' and 'variants'), not a scenario: run it with "
+         "`hexbite study " +
+             ctx.file + " -o DIR`, or give a scenario file");
   const Map root(root_value,
                  {"format_version", "name", "description", "geometry", "landmarks", "mesh", "materials",
                   "muscles", "activation_pattern", "supports", "solver", "outputs", "probes"});

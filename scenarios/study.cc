@@ -178,6 +178,11 @@ Study load_study(const std::string& path) {
     fail(top,
          "the study file is empty; it needs 'name', 'base' (a scenario file) and 'variants' (see "
          "docs/studies.md)");
+  if (root.IsMap() && !root["base"] && !root["variants"] && (root["geometry"] || root["supports"]))
+    fail(top,
+         "this is a scenario file (it has no 'base' and no 'variants'), not a study: run it with "
+         "`hexbite run " +
+             path + " -o DIR`, or make it the base of a study (docs/studies.md)");
   const Map map({&study_source, root, top, ""}, {"name", "description", "base", "variants"}, "the study");
   Study study;
   study.path = path;

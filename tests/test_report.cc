@@ -328,6 +328,12 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   const int cut_line = static_cast<int>(count(cut, "\n")) + 1;
   write_file(dir + "/a_file", "x");
   fs::create_directories(dir + "/empty");
+  // A study's output folder (study.json and a folder per variant), and a folder in the way of solution.vtu.
+  fs::create_directories(dir + "/study/reference");
+  write_file(dir + "/study/study.json", "{}");
+  write_file(dir + "/study/reference/results.json", results);
+  fs::create_directories(dir + "/vtu_folder/solution.vtu");
+  write_file(dir + "/vtu_folder/results.json", results);
   struct Case {
     std::vector<std::string> args;
     std::string fragment;
@@ -348,6 +354,13 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
       {{"report", *run_dir_, "-o", dir + "/r.txt"}, "this command writes .html or .htm"},
       {{"report", *run_dir_, "-o", dir + "/no_such/r.html"}, "folder '" + dir + "/no_such' does not exist"},
       {{"report", *run_dir_, "-o", dir}, "is a folder"},
+      // Said "holds no results.json" and "does not exist".
+      {{"report", dir + "/study", "-o", out},
+       "is the output folder of a study (it holds study.json), and a report is of one run: give the folder "
+       "of "
+       "one of its variants, e.g. '" +
+           dir + "/study/reference'"},
+      {{"report", dir + "/vtu_folder", "-o", out}, "solution.vtu' is a folder, not the run's solution file"},
   };
   for (const Case& c : cases) {
     const test::CommandResult r = run_hexbite(c.args);

@@ -267,6 +267,25 @@ TEST(Study, APointTheStudySetIsNamedAtTheStudysLine) {
   expect_refused(soft_setting("supports.base.at: [0, 10, -300]"), 7, "support 'base'");
 }
 
+// A scenario given to `study`, and a study given to `run`: said "unknown key 'format_version' in the study"
+// and "unknown key 'base' in the scenario; did you mean 'name'?".
+TEST(Study, AScenarioAndAStudyGivenToTheOtherCommandAreNamed) {
+  const std::string dir = study_folder(kStudy);
+  auto r = test::run_hexbite({"study", dir + "/base/cube.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("cube.yaml:1:1: this is a scenario file (it has no 'base' and no 'variants'), not a "
+                       "study: run it with `hexbite run "),
+            std::string::npos)
+      << r.err;
+  r = test::run_hexbite({"run", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("study.yaml:1:1: this is a study file (it has 'base' and 'variants'), not a scenario: "
+                       "run it with `hexbite study "),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 TEST(Study, UnknownKeyAndUnsafeVariantNameAreRefused) {
   expect_refused(kStudy + "varients: []\n", 12,
                  "unknown key 'varients' in the study; did you mean 'variants'?");
