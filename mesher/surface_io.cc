@@ -203,14 +203,24 @@ float get_f32(const std::string& bytes, std::size_t at) {
 // A text STL contains no control characters but white space; any other one (a binary record's zero
 // attribute bytes, for one) means binary, whatever the first 80 bytes say (many binary exporters start
 // their header with "solid"). Bytes from 128 up are text: a solid named in UTF-8 ("solid Unterkiefer_ä").
-bool looks_like_ascii_stl(const std::string& bytes) {
-  std::size_t i = 0;
-  while (i < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[i]))) ++i;
-  if (bytes.compare(i, 5, "solid") != 0) return false;
+bool is_text(const std::string& bytes) {
   return std::all_of(bytes.begin(), bytes.end(), [](char ch) {
     const auto c = static_cast<unsigned char>(ch);
     return (c >= 32 && c != 127) || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v';
   });
+}
+
+// The first word of a text file, after white space.
+std::string first_word(const std::string& bytes) {
+  std::size_t i = 0;
+  while (i < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[i]))) ++i;
+  std::size_t end = i;
+  while (end < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[end]))) ++end;
+  return bytes.substr(i, end - i);
+}
+
+bool looks_like_ascii_stl(const std::string& bytes) {
+  return first_word(bytes).rfind("solid", 0) == 0 && is_text(bytes);
 }
 
 TriSurface read_binary_stl(const std::string& path, const std::string& bytes) {
@@ -292,7 +302,24 @@ TriSurface read_stl(const std::string& path) {
   // word "solid" at the start, decides: binary exporters often begin their header with "solid" too.
   if (bytes.size() >= 84 && bytes.size() == 84 + 50 * std::uint64_t(get_u32(bytes, 80)))
     return read_binary_stl(path, bytes);
-  if (looks_like_ascii_stl(bytes)) return read_ascii_stl(path, bytes);
+  // Some editors start a text file with a UTF-8 byte order mark.
+  const std::string text = bytes.rfind("\xEF\xBB\xBF", 0) == 0 ? bytes.substr(3) : bytes;
+  if (looks_like_ascii_stl(text)) return read_ascii_stl(path, text);
+  // Text that is no ASCII STL was called a corrupt binary STL announcing some billion triangles.
+  if (is_text(text)) {
+    const std::string word = first_word(text);
+    const std::string kind = word == "v" || word == "vn" || word == "f" || word == "o" || word == "g" ||
+                                     word == "mtllib" || word[0] == '#'
+                                 ? "an OBJ file"
+                             : word == "ply"                         ? "a PLY file"
+                             : word.find("OFF") != std::string::npos ? "an OFF file"
+                                                                     : "";
+    throw InputError(
+        "surface file " + quoted(path) + " is not an STL: it is text that does not begin with " +
+        "'solid', as an ASCII STL does" +
+        (kind.empty() ? std::string() : "; it looks like " + kind + ": give it the extension of its format") +
+        (kind.empty() ? "; export it as STL again" : ""));
+  }
   if (bytes.size() < 84)
     throw InputError("surface file " + quoted(path) +
                      " is a truncated binary STL: the header alone needs 84 bytes but the file has " +

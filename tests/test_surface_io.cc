@@ -322,6 +322,20 @@ TEST(SurfaceIoErrors, VtpWithAShortCellDataArray) {
   expect_input_error([&] { read_surface(path); }, {path, "Cannot read cell data array \"a\""});
 }
 
+// Text that is no ASCII STL was "a truncated or corrupt binary STL" announcing 171122740 triangles; an
+// ASCII STL behind a UTF-8 byte order mark too.
+TEST(SurfaceIoErrors, TextThatIsNoStlIsNamedAndAByteOrderMarkIsSkipped) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/cube.stl", kCubeVertices + std::string("f 1 2 3\n"));
+  expect_input_error(
+      [&] { read_surface(dir + "/cube.stl"); },
+      {"is not an STL: it is text that does not begin with 'solid'", "it looks like an OBJ file"});
+  write_file(dir + "/bom.stl",
+             "\xEF\xBB\xBFsolid c\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+             "endloop\nendfacet\nendsolid c\n");
+  EXPECT_EQ(read_surface(dir + "/bom.stl").triangles.size(), 1u);
+}
+
 TEST(SurfaceIoErrors, UnknownExtension) {
   const std::string path = temp_dir() + "/cube.xyz";
   write_file(path, kCubeVertices);
