@@ -33,6 +33,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/paths.h"
+#include "mesher/units.h"
 #include "mesher/vtk_messages.h"
 
 namespace hexbite {
@@ -926,6 +927,16 @@ TriSurface read_surface(const std::string& path, double scale_to_mm) {
                      "vertex " + std::to_string(i) + " (0-based) after scaling to mm by " + num(scale_to_mm),
                      s.vertices[i]);
   }
+  // A coordinate of a kilometre and more is a damaged file or a wrong unit, never a bone: the geometry's
+  // predicates lose their precision there (the mesher stopped on a CGAL assertion), and an STL written from
+  // it held infinities (its coordinates are floats).
+  for (std::size_t i = 0; i < s.vertices.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(s.vertices[i][a]) > kMaxCoordinateMm)
+        throw InputError("surface file " + quoted(path) + ": vertex " + std::to_string(i) +
+                         " (0-based) has the " + "xyz"[a] + " coordinate " + num(s.vertices[i][a]) +
+                         " mm, beyond " + num(kMaxCoordinateMm) +
+                         " mm in size: the file is damaged or its unit is wrong (--units)");
   return s;
 }
 

@@ -336,6 +336,16 @@ TEST(SurfaceIoErrors, TextThatIsNoStlIsNamedAndAByteOrderMarkIsSkipped) {
   EXPECT_EQ(read_surface(dir + "/bom.stl").triangles.size(), 1u);
 }
 
+// Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
+// infinities (1e40 does not fit a float), `mesh` stopped on a CGAL assertion (1e16).
+TEST(SurfaceIoErrors, CoordinatesBeyondAKilometreAreRefused) {
+  const std::string path = temp_dir() + "/huge.obj";
+  write_file(path, "v 0 0 0\nv 1e16 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  expect_input_error([&] { read_surface(path); },
+                     {"vertex 1 (0-based) has the x coordinate 1e+16 mm, beyond 1e+06 mm in size"});
+  EXPECT_EQ(read_surface(path, 1e-12).triangles.size(), 4u);  // the limit is on millimetres
+}
+
 TEST(SurfaceIoErrors, UnknownExtension) {
   const std::string path = temp_dir() + "/cube.xyz";
   write_file(path, kCubeVertices);
