@@ -488,6 +488,13 @@ HexMesh read_msh(const std::string& path) {
         r.fail("hexahedron " + std::to_string(tag) + " refers to node " + std::to_string(nodes[k]) +
                ", which is not in $Nodes");
       hex[k] = it->second;
+      // Named here by the file's tags (check_mesh() would give the reader's 0-based numbers).
+      for (int j = 0; j < k; ++j)
+        if (nodes[j] == nodes[k])
+          r.fail("hexahedron " + std::to_string(tag) + " lists node " + std::to_string(nodes[k]) +
+                 " twice (corners " + std::to_string(j + 1) + " and " + std::to_string(k + 1) +
+                 " of 8); a hexahedron needs 8 distinct nodes: collapsed hexes are not supported, fix the "
+                 "connectivity where the mesh was made");
     }
     mesh.hexes.push_back(hex);
   };
@@ -528,6 +535,10 @@ HexMesh read_msh(const std::string& path) {
             add_node(t, p);
           }
         }
+        // A count the blocks do not reach: a section cut or edited by hand.
+        if (static_cast<long>(mesh.vertices.size()) != count)
+          r.fail("the $Nodes section announces " + std::to_string(count) + " nodes, but its blocks hold " +
+                 std::to_string(mesh.vertices.size()));
       } else {
         auto s = r.numbers();
         long count = 0;
@@ -549,11 +560,13 @@ HexMesh read_msh(const std::string& path) {
         auto s = r.numbers();
         long blocks = 0, count = 0, lo = 0, hi = 0;
         r.read(s, blocks, count, lo, hi);
+        long elements = 0;
         for (long b = 0; b < blocks; ++b) {
           auto bs = r.numbers();
           int dim = 0, entity = 0, type = 0;
           long in_block = 0;
           r.read(bs, dim, entity, type, in_block);
+          elements += in_block;
           for (long i = 0; i < in_block; ++i) {
             auto es = r.numbers();
             long tag = 0, v = 0;
@@ -563,6 +576,9 @@ HexMesh read_msh(const std::string& path) {
             add_element(tag, type, nodes);
           }
         }
+        if (elements != count)
+          r.fail("the $Elements section announces " + std::to_string(count) +
+                 " elements, but its blocks hold " + std::to_string(elements));
       } else {
         auto s = r.numbers();
         long count = 0;

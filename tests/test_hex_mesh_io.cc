@@ -204,7 +204,15 @@ TEST(HexMeshIo, ReadersRejectMeshesWithoutHexesOrWithCollapsedHexes) {
   EXPECT_NE(msg.find("quads.msh' holds no hexahedra"), std::string::npos) << msg;
   write_file(dir + "/collapsed.msh", header + "1 5 2 0 1 1 2 3 4 5 6 6 8\n$EndElements\n");
   msg = test::message_of<InputError>([&] { read_msh(dir + "/collapsed.msh"); });
-  EXPECT_NE(msg.find("hexahedron 0 lists vertex 5 twice"), std::string::npos) << msg;
+  // By the file's element and node tags and its line (was "hexahedron 0 lists vertex 5": 0-based numbers).
+  EXPECT_NE(msg.find("line 17: hexahedron 1 lists node 6 twice (corners 6 and 7 of 8)"), std::string::npos)
+      << msg;
+  // A node count the blocks do not reach was read without a word.
+  write_file(dir + "/count.msh",
+             "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 99 1 99\n3 1 0 1\n1\n0 0 0\n$EndNodes\n");
+  msg = test::message_of<InputError>([&] { read_msh(dir + "/count.msh"); });
+  EXPECT_NE(msg.find("the $Nodes section announces 99 nodes, but its blocks hold 1"), std::string::npos)
+      << msg;
 
   for (const char* count : {"1000000000000000", "-5"}) {
     write_file(dir + "/block.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n3 1 0 " +
