@@ -92,10 +92,11 @@ void add_run_command(CLI::App& app) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->check(CLI::Validator(
           [](std::string& format) -> std::string {
-            return format == "inp"
-                       ? std::string()
-                       : "unknown format '" + format +
-                             "': the one format is inp (CalculiX); the VTU files are always written";
+            return format == "inp" ? std::string()
+                                   : "unknown format '" + format +
+                                         "': the one format is inp (CalculiX); the VTU files are written "
+                                         "unless the scenario says "
+                                         "outputs.vtu: false";
           },
           "inp"));
   cmd->add_option(

@@ -278,9 +278,11 @@ double strain_energy(const ElasticitySolution& u) {
 void check_inp_exportable(const Scenario& scenario) {
   for (const Support& s : scenario.supports)
     if (s.spring_N_per_mm3)
-      throw InputError(s.where.str() + ": support '" + s.name +
-                       "' is a spring (spring_N_per_mm3), which the CalculiX export does not write; "
-                       "use fixed components for the comparison with CalculiX, or run without --export inp");
+      throw InputError(
+          s.where.str() + ": support '" + s.name +
+          "' is a spring (spring_N_per_mm3), which the CalculiX export does not write; "
+          "use fixed components for the comparison with CalculiX, or leave the export out (--export inp, "
+          "outputs.inp)");
   // Names that differ only in case or in characters other than letters and digits ("condyle" and
   // "CONDYLE", "left condyle" and "left_condyle") give one set name: write_inp refused it after the solve
   // (exit 1, mesh.vtu already written, no results.json). Refused here, before anything runs.
@@ -292,7 +294,8 @@ void check_inp_exportable(const Scenario& scenario) {
           where.str() + ": " + what + " and " + it->second.first + " (line " +
           std::to_string(it->second.second.line) + ") get the same CalculiX set name " + set +
           " (set names keep letters, digits and '_', in upper case, up to 80 characters), so the "
-          "export would mix their nodes; rename one of them, or run without --export inp");
+          "export would mix their nodes; rename one of them, or leave the export out (--export inp, "
+          "outputs.inp)");
   };
   for (const Support& s : scenario.supports)
     claim(set_name("SUP_", s.name), "support '" + s.name + "'", s.where);

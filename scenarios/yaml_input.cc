@@ -129,6 +129,9 @@ Map::Map(const Value& v, std::vector<std::string> valid, std::string document)
     if (!it->first.IsScalar())
       fail(key_at, "a key of " + what() + " is not a plain word; write 'key: value'");
     const std::string key = it->first.Scalar();
+    if (key == "<<")
+      fail(key_at, "YAML merge keys ('<<: *anchor') are not read in " + what() +
+                       "; write the keys out (a whole aliased value, 'key: *anchor', is read)");
     if (std::find(valid.begin(), valid.end(), key) == valid.end())
       fail(key_at, "unknown key " + quote(key) + " in " + what() + "; " + suggestion(key, valid, "keys"));
     if (const auto previous = entries_.find(key); previous != entries_.end())
@@ -268,8 +271,8 @@ YAML::Node parse_yaml_document(const std::string& text, const std::string& file,
   for (size_t i = 1; i < documents.size(); ++i)
     if (!documents[i].IsNull())
       fail({file, documents[i].Mark().line + 1, 1},
-           "a second YAML document starts here (after a '---' line); a " + kind + " file holds one " + kind +
-               ": put each " + kind + " in its own file");
+           "a second YAML document starts here (after a '---' or '...' line); a " + kind +
+               " file holds one " + kind + ": put each " + kind + " in its own file");
   return documents.empty() ? YAML::Node() : documents.front();
 }
 

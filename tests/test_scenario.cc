@@ -553,6 +553,18 @@ TEST(ScenarioErrors, ImplausibleForceTargetOrCoordinates) {
 TEST(ScenarioErrors, ASecondYamlDocumentIsRefused) {
   EXPECT_ERROR_AT(error_of(kValid + "---\nname: other\n"), 12, "a second YAML document starts here");
   EXPECT_NO_THROW(load_scenario(write_scenario(kValid + "---\n")));  // an empty one changes nothing
+  // After a document end marker the message named only '---'.
+  EXPECT_ERROR_AT(error_of(kValid + "...\nprobes: []\n"), 12, "(after a '---' or '...' line)");
+}
+
+// yaml-cpp does not resolve merge keys: `<<: *anchor` was "unknown key '<<' in supports[1]".
+TEST(ScenarioErrors, AMergeKeyIsNamed) {
+  const std::string merged =
+      replace(replace(kValid, "  - {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}",
+                      "  - &c {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}"),
+              "  - {name: left_condyle, at: left_condyle_tmj_point, radius_mm: 6}",
+              "  - {<<: *c, name: left_condyle, at: left_condyle_tmj_point}");
+  EXPECT_ERROR_AT(error_of(merged), 10, "YAML merge keys ('<<: *anchor') are not read in supports[2]");
 }
 
 TEST(ScenarioErrors, ZeroLineOfAction) {
