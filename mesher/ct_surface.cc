@@ -183,23 +183,37 @@ void flip_axis(VoxelVolume& v, int axis) {
       }
 }
 
+// The next "Key = values" line of a MetaImage text header in `in` (lines without '=' are skipped, at most
+// 200 lines are read): its key without white space and its values; `line` counts the lines read. False at
+// the end.
+bool next_header_entry(std::istream& in, int& line, std::string& key, std::istringstream& values) {
+  std::string text;
+  while (line < 200 && std::getline(in, text)) {
+    ++line;
+    const auto eq = text.find('=');
+    if (eq == std::string::npos) continue;
+    key = text.substr(0, eq);
+    key.erase(std::remove_if(key.begin(), key.end(), [](unsigned char c) { return std::isspace(c); }),
+              key.end());
+    values = std::istringstream(text.substr(eq + 1));
+    return true;
+  }
+  return false;
+}
+
 // VTK's MetaImage reader ignores the grid's direction (TransformMatrix, also spelled Rotation or
 // Orientation) and the sign of ElementSpacing, so both are read from the text header here and
 // turned into an orientation matrix like NIfTI's qform: a grid stored with a flipped or rotated
 // axis would otherwise come out mirrored or in the wrong place without a word.
 vtkSmartPointer<vtkMatrix4x4> metaimage_orientation(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::string line;
   std::array<double, 9> m = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   std::array<double, 3> sign = {1, 1, 1};
   int dims = 3;  // NDims comes before the matrix in every MetaImage header
-  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
-    const auto eq = line.find('=');
-    if (eq == std::string::npos) continue;
-    std::string key = line.substr(0, eq);
-    key.erase(std::remove_if(key.begin(), key.end(), [](unsigned char c) { return std::isspace(c); }),
-              key.end());
-    std::istringstream values(line.substr(eq + 1));
+  int line = 0;
+  std::string key;
+  std::istringstream values;
+  while (next_header_entry(in, line, key, values)) {
     if (key == "NDims") {
       if (!(values >> dims) || dims < 1 || dims > 3) dims = 3;  // VTK's reader judges the rest
     } else if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation") {
@@ -207,7 +221,7 @@ vtkSmartPointer<vtkMatrix4x4> metaimage_orientation(const std::string& path) {
       for (int r = 0; r < dims; ++r)
         for (int c = 0; c < dims; ++c)
           if (!(values >> m[3 * r + c]))
-            throw InputError("'" + path + "' header line " + std::to_string(n + 1) + ": " + key +
+            throw InputError("'" + path + "' header line " + std::to_string(line) + ": " + key +
                              " must hold " + std::to_string(dims * dims) + " numbers (the " +
                              std::to_string(dims) + " x " + std::to_string(dims) + " direction matrix)");
     } else if (key == "ElementSpacing") {
@@ -233,16 +247,12 @@ vtkSmartPointer<vtkMatrix4x4> metaimage_orientation(const std::string& path) {
 // bone without a word.
 std::uintmax_t metaimage_extra_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::string line, data_file, type;
+  std::string data_file, type, key;
   std::uintmax_t voxels = 1, channels = 1;
   bool compressed = false, known = false;
-  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
-    const auto eq = line.find('=');
-    if (eq == std::string::npos) continue;
-    std::string key = line.substr(0, eq);
-    key.erase(std::remove_if(key.begin(), key.end(), [](unsigned char c) { return std::isspace(c); }),
-              key.end());
-    std::istringstream values(line.substr(eq + 1));
+  int line = 0;
+  std::istringstream values;
+  while (next_header_entry(in, line, key, values)) {
     if (key == "DimSize") {
       voxels = 1;
       for (long d = 0; values >> d;) voxels *= static_cast<std::uintmax_t>(std::max(d, 0L));
