@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <set>
+#include <map>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -24,6 +24,18 @@ namespace {
   std::string where = path;
   if (!mark.is_null()) where += ":" + std::to_string(mark.line + 1);
   throw InputError("landmark file " + where + ": " + what);
+}
+
+// Records that `name` is given at `mark`; a name given twice (a landmark and a muscle share the names) is
+// refused with the line of its first place.
+void claim_name(const std::string& path, const YAML::Mark& mark, const std::string& name,
+                std::map<std::string, int>& names) {
+  const auto [first, fresh] = names.emplace(name, mark.is_null() ? 0 : mark.line + 1);
+  if (!fresh)
+    fail(path, mark,
+         "name '" + name + "' is given twice" +
+             (first->second > 0 ? " (first on line " + std::to_string(first->second) + ")" : std::string()) +
+             "; keep one");
 }
 
 double read_number(const std::string& path, const YAML::Node& node, const std::string& what) {
@@ -56,7 +68,7 @@ Vec3 read_point(const std::string& path, const YAML::Node& node, const std::stri
 }
 
 void read_muscle(const std::string& path, const YAML::Node& node, double scale, Landmarks& out,
-                 std::set<std::string>& names) {
+                 std::map<std::string, int>& names) {
   if (!node.IsMap())
     fail(path, node.Mark(), "each muscle must be a map {name, max_force_N, insertion, origin}");
   MuscleLine m;
@@ -99,7 +111,7 @@ void read_muscle(const std::string& path, const YAML::Node& node, double scale, 
       fail(
           path, node.Mark(),
           std::string("muscle ") + (m.name.empty() ? "" : "'" + m.name + "' ") + "has no '" + kKeys[k] + "'");
-  if (!names.insert(m.name).second) fail(path, node.Mark(), "name '" + m.name + "' is given twice");
+  claim_name(path, node.Mark(), m.name, names);
   out.muscles.push_back(std::move(m));
 }
 
@@ -146,7 +158,7 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
   if (!root.IsMap()) fail(path, root.Mark(), "expected a map with 'landmarks:' and 'muscles:'");
 
   Landmarks out;
-  std::set<std::string> names;
+  std::map<std::string, int> names;  // name -> the 1-based line where it is first given
   try {
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();
@@ -156,7 +168,7 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
         if (!value.IsMap()) fail(path, value.Mark(), "'landmarks' must map names to [x, y, z]");
         for (const auto& lm : value) {
           const std::string name = lm.first.as<std::string>();
-          if (!names.insert(name).second) fail(path, lm.first.Mark(), "name '" + name + "' is given twice");
+          claim_name(path, lm.first.Mark(), name, names);
           out.points[name] = read_point(path, lm.second, "landmark '" + name + "'", scale_to_mm);
         }
       } else if (key == "muscles") {
@@ -164,7 +176,12 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
         if (!value.IsSequence()) fail(path, value.Mark(), "'muscles' must be a list");
         for (const auto& m : value) read_muscle(path, m, scale_to_mm, out, names);
       } else {
-        fail(path, kv.first.Mark(), "unknown section '" + key + "' (expected 'landmarks' and 'muscles')");
+        fail(path, kv.first.Mark(),
+             "unknown section '" + key + "' (expected 'landmarks' and 'muscles')" +
+                 (key == "units"
+                      ? "; the file's unit is given where it is read: a scenario's landmarks.units, "
+                        "or --units"
+                      : ""));
       }
     }
   } catch (const YAML::Exception& e) {

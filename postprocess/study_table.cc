@@ -59,6 +59,9 @@ std::string csv_number(const json& value) {
 std::string markdown_cell(std::string text) {
   for (std::size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2))
     text.replace(at, 1, "\\|");
+  // A line break (a set value "a\nb") ended the table row.
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace(text.begin(), text.end(), '\r', ' ');
   return text;
 }
 

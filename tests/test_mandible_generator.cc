@@ -359,7 +359,12 @@ TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
   expect_landmark_error("muscles:\n  - {name: m, max_force_N: -1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
                         "must not be negative");
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n", ":3: unknown section 'muscle'");
-  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  a: [1, 2, 4]\n", "given twice");
+  expect_landmark_error("units: cm\nlandmarks:\n  a: [1, 2, 3]\n",
+                        ":1: unknown section 'units' (expected "
+                        "'landmarks' and 'muscles'); the file's unit is given where it is read: a scenario's "
+                        "landmarks.units, or --units");
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  a: [1, 2, 4]\n",
+                        ":3: name 'a' is given twice (first on line 2)");
   expect_landmark_error("", "is empty");
   // yaml-cpp alone says "bad conversion" for a list used as a name.
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  ? [x, y]\n  : [1, 2, 3]\n",

@@ -5,6 +5,7 @@
 // folder as it was. A 20 mm cube of a few hundred hexes keeps every solve well under a second.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "postprocess/study_table.h"
 #include "scenarios/study.h"
 #include "tests/test_util.h"
 
@@ -215,6 +217,25 @@ std::string soft_setting(const std::string& set_line) {
   std::string study = kStudy;
   study.replace(study.find("materials.default.E_MPa: 5500"), 29, set_line);
   return study;
+}
+
+// A line break in a value the study set (description: "a\nb") ended the study.md table row.
+TEST(StudyTable, ALineBreakInAChangeStaysInItsRow) {
+  nlohmann::ordered_json variant = {{"name", "a"},
+                                    {"set", {{"description", "two\nlines"}}},
+                                    {"level", 0},
+                                    {"hexes", 8},
+                                    {"bite_force_N", 1.0},
+                                    {"max_displacement_mm", 1.0},
+                                    {"von_mises_max_MPa", 1.0},
+                                    {"von_mises_p99_MPa", 1.0},
+                                    {"strain_energy_mJ", 1.0},
+                                    {"reactions", nlohmann::ordered_json::object()},
+                                    {"relative_to_reference", nlohmann::ordered_json::object()}};
+  const nlohmann::ordered_json study = {{"variants", {variant}}};
+  const std::string md = study_markdown(study);
+  EXPECT_EQ(std::count(md.begin(), md.end(), '\n'), 3) << md;  // header, rule, one row
+  EXPECT_NE(md.find("two lines"), std::string::npos) << md;
 }
 
 TEST(Study, UnknownKeyOnThePathIsRefusedWithTheKeysThere) {
