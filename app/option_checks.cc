@@ -10,6 +10,8 @@
 
 #include <unistd.h>
 
+#include "common/paths.h"
+
 namespace hexbite {
 namespace {
 
@@ -66,8 +68,7 @@ std::string cannot_make_entries(const fs::path& dir) {
 // Why a name of `path` below the existing folder `existing` is longer than that folder's file system allows
 // (255 bytes on most), or empty: found only when the outputs are written, after the work, otherwise.
 std::string name_too_long(const fs::path& existing, const fs::path& path) {
-  const long limit = ::pathconf(existing.c_str(), _PC_NAME_MAX);
-  const std::size_t most = limit > 0 ? static_cast<std::size_t>(limit) : 255;
+  const std::size_t most = longest_name_in(existing.string());
   for (const fs::path& part : path.lexically_relative(existing))
     if (part.string().size() > most)
       return "a name in it is " + std::to_string(part.string().size()) + " bytes long, more than the " +

@@ -354,10 +354,10 @@ constexpr double kProbeMaxOutsideMm = 5.0;
 // mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
 // centre of the hex behind it, so that one hex contains it; results.json reports the requested point and
 // the distance moved. A point farther outside than kProbeMaxOutsideMm is refused at its line.
-std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const std::vector<Probe>& probes) {
+std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& boundary,
+                                       const std::vector<Probe>& probes) {
   std::vector<Vec3> points;
   if (probes.empty()) return points;
-  const HexBoundary boundary = extract_boundary(mesh);
   const SurfaceProjector mesh_boundary(fan_triangles(boundary.surface));
   for (const Probe& probe : probes) {
     const Vec3& p = probe.at.xyz;
@@ -406,7 +406,7 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
     r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
                                              point_place(sup.at, sup.where), "support '" + sup.name + "'"));
   // Here, not before the solve: a probe far outside the mesh must not cost a study its earlier variants.
-  r.probe_points = probe_points_in_mesh(r.mesh, s.probes);
+  r.probe_points = probe_points_in_mesh(r.mesh, boundary, s.probes);
   r.hex_material.reserve(r.mesh.hexes.size());
   // A hex takes a region's material by its centre; a region that wins no hex changes nothing, which
   // must not pass for a simulated implant or resorption site. Checked on the coarse mesh (finer levels

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "common/error.h"
+#include "common/paths.h"
 
 namespace hexbite {
 
@@ -44,8 +45,7 @@ std::string temporary_path_beside(const std::string& final_path, const std::stri
   const std::string name = target.filename().string();
   std::string stem = name.substr(0, name.size() - std::min(name.size(), extension.size()));
   const std::string tag = ".tmp" + std::to_string(::getpid());
-  const long limit = ::pathconf(dir.c_str(), _PC_NAME_MAX);
-  const std::size_t most = limit > 0 ? static_cast<std::size_t>(limit) : 255;
+  const std::size_t most = longest_name_in(dir.string());
   const std::size_t added = 1 + tag.size() + extension.size();
   if (stem.size() + added > most) stem.resize(most > added ? most - added : 0);
   return (dir / ("." + stem + tag + extension)).string();

@@ -1,5 +1,7 @@
 #include "common/paths.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -18,6 +20,11 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 std::string quoted(const std::string& path) {
   return "'" + path + "'";
+}
+
+std::size_t longest_name_in(const std::string& dir) {
+  const long limit = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  return limit > 0 ? static_cast<std::size_t>(limit) : 255;
 }
 
 }  // namespace hexbite

@@ -1,6 +1,7 @@
 // Small helpers on file names shared by the readers, writers and commands.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace hexbite {
@@ -13,5 +14,9 @@ bool ends_with(const std::string& s, const std::string& suffix);
 
 // `path` in single quotes, the way error messages name files.
 std::string quoted(const std::string& path);
+
+// The longest file name, in bytes, that the file system of the existing folder `dir` takes (255 on most,
+// and 255 when it does not say).
+std::size_t longest_name_in(const std::string& dir);
 
 }  // namespace hexbite

@@ -5,7 +5,6 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
-#include <regex>
 #include <sstream>
 #include <utility>
 
@@ -83,7 +82,8 @@ bool decimal_whole_number(const YAML::Node& node, long long* value) {
   const std::string& text = node.Scalar();
   if (text.find_first_of("xXoO") != std::string::npos) return false;
   double x = 0;
-  if (std::regex_match(text, std::regex("[-+]?[0-9]+")))
+  const std::size_t digits = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;  // after a sign
+  if (text.size() > digits && text.find_first_not_of("0123456789", digits) == std::string::npos)
     x = std::stod(text);  // decimal, leading zeros and all
   else if (!YAML::convert<double>::decode(node, x) || !std::isfinite(x) || x != std::floor(x))
     return false;
