@@ -56,7 +56,8 @@ std::vector<MeshArray> permute_arrays(const std::vector<MeshArray>& arrays, cons
     if (std::find(std::begin(kVtuQualityArrays), std::end(kVtuQualityArrays), a.name) !=
         std::end(kVtuQualityArrays))
       continue;
-    MeshArray p{a.name, a.components, {}};
+    MeshArray p = a;
+    p.values.clear();
     p.values.reserve(a.values.size());
     for (int i : order)
       for (int c = 0; c < a.components; ++c)

@@ -4,7 +4,6 @@
 #include <vtkCellData.h>
 #include <vtkCellTypes.h>
 #include <vtkDataArray.h>
-#include <vtkDoubleArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
@@ -113,13 +112,17 @@ void check_arrays(const std::vector<MeshArray>& arrays, std::size_t count, const
   }
 }
 
-vtkSmartPointer<vtkDoubleArray> make_vtk_array(const std::string& name, int components,
-                                               const std::vector<double>& values) {
-  auto array = vtkSmartPointer<vtkDoubleArray>::New();
-  array->SetName(name.c_str());
-  array->SetNumberOfComponents(components);
-  array->SetNumberOfTuples(static_cast<vtkIdType>(values.size() / components));
-  std::copy(values.begin(), values.end(), array->GetPointer(0));
+static_assert(VTK_DOUBLE == 11, "MeshArray::vtk_type's default is VTK_DOUBLE");
+
+vtkSmartPointer<vtkDataArray> make_vtk_array(const MeshArray& a) {
+  vtkSmartPointer<vtkDataArray> array;
+  array.TakeReference(vtkDataArray::CreateDataArray(a.vtk_type));
+  array->SetName(a.name.c_str());
+  array->SetNumberOfComponents(a.components);
+  array->SetNumberOfTuples(static_cast<vtkIdType>(a.values.size() / a.components));
+  for (std::size_t i = 0; i < a.values.size(); ++i)
+    array->SetComponent(static_cast<vtkIdType>(i / a.components), static_cast<int>(i % a.components),
+                        a.values[i]);
   return array;
 }
 
@@ -131,6 +134,7 @@ std::vector<MeshArray> arrays_of(vtkFieldData* data) {
     MeshArray m;
     m.name = a->GetName() ? a->GetName() : "";
     m.components = a->GetNumberOfComponents();
+    m.vtk_type = a->GetDataType();
     m.values.resize(static_cast<std::size_t>(a->GetNumberOfTuples()) * m.components);
     for (vtkIdType t = 0; t < a->GetNumberOfTuples(); ++t)
       for (int c = 0; c < m.components; ++c) m.values[t * m.components + c] = a->GetComponent(t, c);
@@ -171,11 +175,9 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
   const HexQualityField q = compute_hex_quality(mesh);
   const std::vector<double>* quality[4] = {&q.scaled_jacobian, &q.condition, &q.oddy, &q.jacobian};
   for (int i = 0; i < 4; ++i)
-    grid->GetCellData()->AddArray(make_vtk_array(kVtuQualityArrays[i], 1, *quality[i]));
-  for (const MeshArray& a : cell_arrays)
-    grid->GetCellData()->AddArray(make_vtk_array(a.name, a.components, a.values));
-  for (const MeshArray& a : point_arrays)
-    grid->GetPointData()->AddArray(make_vtk_array(a.name, a.components, a.values));
+    grid->GetCellData()->AddArray(make_vtk_array({kVtuQualityArrays[i], 1, *quality[i]}));
+  for (const MeshArray& a : cell_arrays) grid->GetCellData()->AddArray(make_vtk_array(a));
+  for (const MeshArray& a : point_arrays) grid->GetPointData()->AddArray(make_vtk_array(a));
 
   // Into memory first, then written and checked like every other file: VTK writing to the file itself did
   // not notice a write that failed (a full disk, a file size limit), and left a truncated file with exit 0.

@@ -17,11 +17,15 @@
 
 namespace hexbite {
 
-// A named array with `components` values per cell or per point, stored tuple after tuple.
+// A named array with `components` values per cell or per point, stored tuple after tuple. `vtk_type` is the
+// VTK data type it is written as (vtkType.h's ids; VTK_DOUBLE = 11 by default) and the type it was read as,
+// so that a VTU read and written again keeps its integer arrays integer; the values pass through doubles,
+// exact for integers up to 2^53.
 struct MeshArray {
   std::string name;
   int components = 1;
   std::vector<double> values;
+  int vtk_type = 11;
 };
 
 // A named set of 0-based node or element indices, for solver input files.

@@ -9,6 +9,8 @@
 #include <random>
 #include <set>
 
+#include <vtkType.h>
+
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_block.h"
 #include "mesher/hex_boundary.h"
@@ -189,6 +191,41 @@ TEST(HexReorderCommand, ReordersAndReports) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["start"]["hex"], nearest_boundary_hex(mesh, {0, 0, 0}));
+}
+
+// The input's arrays come out in the new order and with their own types: an Int32 material id stays Int32 (it
+// was written back as Float64, which readers that expect integer ids refuse).
+TEST(HexReorderCommand, ArraysKeepTheirValuesAndTypes) {
+  const std::string dir = temp_dir();
+  const HexMesh mesh = shuffled(make_block_mesh(3, 3, 3), 5);
+  MeshArray material{"material", 1, {}, VTK_INT};
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) material.values.push_back(double(h));
+  MeshArray node_id{"node_id", 1, {}, VTK_LONG_LONG};
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) node_id.values.push_back(double(v) + 1e12);
+  write_vtu(dir + "/in.vtu", mesh, {material}, {node_id});
+  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<MeshArray> cells, points;
+  read_vtu(dir + "/rcm.vtu", &cells, &points);
+  const ReorderResult expected = reorder_reverse_cuthill_mckee(mesh);
+  const auto named = [](const std::vector<MeshArray>& arrays, const std::string& name) {
+    const auto it =
+        std::find_if(arrays.begin(), arrays.end(), [&](const MeshArray& a) { return a.name == name; });
+    EXPECT_NE(it, arrays.end()) << name;
+    return it == arrays.end() ? MeshArray{} : *it;
+  };
+  const MeshArray cell = named(cells, "material"), point = named(points, "node_id");
+  EXPECT_EQ(cell.vtk_type, VTK_INT);
+  EXPECT_EQ(point.vtk_type, VTK_LONG_LONG);
+  ASSERT_EQ(cell.values.size(), mesh.hexes.size());
+  ASSERT_EQ(point.values.size(), mesh.vertices.size());
+  for (std::size_t i = 0; i < expected.hex_order.size(); ++i)
+    EXPECT_EQ(cell.values[i], double(expected.hex_order[i]));
+  for (std::size_t i = 0; i < expected.node_order.size(); ++i)
+    EXPECT_EQ(point.values[i], double(expected.node_order[i]) + 1e12);
+  const std::string text = test::read_file(dir + "/rcm.vtu");
+  EXPECT_NE(text.find("type=\"Int32\" Name=\"material\""), std::string::npos);
+  EXPECT_NE(text.find("type=\"Int64\" Name=\"node_id\""), std::string::npos);
 }
 
 TEST(HexReorderCommand, BadInput) {
