@@ -615,8 +615,9 @@ TriSurface read_ply(const std::string& path) {
   if (has_vertices && (coordinate[0] < 0 || coordinate[1] < 0 || coordinate[2] < 0))
     throw InputError(quoted(path) + ": the PLY element 'vertex' lacks one of the properties x, y, z");
 
-  // The records follow the header line by line (ASCII) or byte by byte (binary). Vertices must come
-  // before the faces that use them, as every PLY writer does.
+  // The records follow the header line by line (ASCII) or byte by byte (binary). The faces' vertex lists are
+  // checked after every element is read: the vertex element usually comes first, but the format allows
+  // either order (a face element first was said to refer to vertices "out of range: the file has 0").
   std::size_t at = std::min(lines.position(), bytes.size());
   const bool binary = format != PlyFormat::kAscii;
   const bool big = format == PlyFormat::kBig;
@@ -624,7 +625,8 @@ TriSurface read_ply(const std::string& path) {
   const std::size_t header_lines = lines.line();
   std::vector<double> scalars;
   std::vector<long long> list;
-  std::vector<int> corners;
+  std::vector<long long> face_indices;  // every face's list, one after another
+  std::vector<std::size_t> face_ends;   // where each face's list ends in face_indices
   for (const PlyElement& e : elements) {
     const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
     for (long long r = 0; r < e.count; ++r) {
@@ -685,17 +687,23 @@ TriSurface read_ply(const std::string& path) {
         if (list.size() < 3)
           throw InputError(quoted(path) + ": " + record + " has " + std::to_string(list.size()) +
                            " vertices; a face needs at least three");
-        corners.clear();
-        for (long long index : list) {
-          if (index < 0 || index >= static_cast<long long>(s.vertices.size()))
-            throw InputError(quoted(path) + ": " + record + " refers to vertex " + std::to_string(index) +
-                             ", which is out of range: the file has " + std::to_string(s.vertices.size()) +
-                             " vertices (0-based indices); fix the face");
-          corners.push_back(static_cast<int>(index));
-        }
-        add_fanned(s, corners);
+        face_indices.insert(face_indices.end(), list.begin(), list.end());
+        face_ends.push_back(face_indices.size());
       }
     }
+  }
+  std::vector<int> corners;
+  for (std::size_t f = 0, begin = 0; f < face_ends.size(); begin = face_ends[f++]) {
+    corners.clear();
+    for (std::size_t k = begin; k < face_ends[f]; ++k) {
+      const long long index = face_indices[k];
+      if (index < 0 || index >= static_cast<long long>(s.vertices.size()))
+        throw InputError(quoted(path) + ": face " + std::to_string(f) + " (0-based) refers to vertex " +
+                         std::to_string(index) + ", which is out of range: the file has " +
+                         std::to_string(s.vertices.size()) + " vertices (0-based indices); fix the face");
+      corners.push_back(static_cast<int>(index));
+    }
+    add_fanned(s, corners);
   }
   return s;
 }

@@ -266,6 +266,27 @@ TEST(SurfaceIo, AsciiPlyWithExtraProperties) {
   EXPECT_NEAR(r.volume_mm3, 1.0, 1e-12);
 }
 
+// The format lets the face element come before the vertex element; such a file reads like the usual order
+// (its faces were said to refer to vertices "out of range: the file has 0 vertices").
+TEST(SurfaceIo, PlyWithFacesBeforeVertices) {
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement face 6\nproperty list uchar int vertex_indices\nelement vertex 8\n"
+      "property float x\nproperty float y\nproperty float z\nend_header\n"
+      "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n"
+      "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n";
+  const std::string dir = temp_dir();
+  write_file(dir + "/cube.ply", text);
+  TriSurface s = read_surface(dir + "/cube.ply");
+  const SurfaceReport r = check_surface(s);
+  EXPECT_TRUE(r.usable());
+  EXPECT_NEAR(r.volume_mm3, 1.0, 1e-12);
+  std::string bad = text;
+  bad.replace(bad.find("4 1 3 7 5"), 9, "4 1 3 7 8");
+  write_file(dir + "/bad.ply", bad);
+  expect_input_error([&] { read_surface(dir + "/bad.ply"); },
+                     {"face 5 (0-based) refers to vertex 8", "the file has 8 vertices"});
+}
+
 TEST(SurfaceIo, BigEndianPly) {
   std::string bytes =
       "ply\nformat binary_big_endian 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
