@@ -1,21 +1,43 @@
 // Error types that map to the command line's exit codes: bad input or usage (2) and failed runs (1).
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace hexbite {
 
+// The message with control bytes other than line breaks and tabs written as \xNN. Messages quote lines and
+// names from the user's files, and a NUL byte in one (binary bytes in a text file) cut the message there:
+// what() is a C string, so the file's line and the advice after it were lost.
+inline std::string printable_message(const std::string& message) {
+  std::string out;
+  out.reserve(message.size());
+  for (const char c : message) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte != 0x7f) {
+      out += c;
+    } else if (c == '\n' || c == '\t') {
+      out += c;
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+      out += escaped;
+    }
+  }
+  return out;
+}
+
 // The user's input (a file, an option, a scenario) is wrong; the message says where and what to do.
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit InputError(const std::string& message) : std::runtime_error(printable_message(message)) {}
 };
 
 // The input was acceptable but the run could not finish (a solver diverged, a mesh stayed inverted).
 class RunError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit RunError(const std::string& message) : std::runtime_error(printable_message(message)) {}
 };
 
 enum ExitCode : int { kExitOk = 0, kExitRunFailed = 1, kExitBadInput = 2 };

@@ -11,9 +11,12 @@
 #include <vtkXMLReader.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <new>
 
 #include "common/error.h"
@@ -68,6 +71,32 @@ bool cell_data_without_point_data(vtkXMLDataElement* e, std::string* unnamed, in
     ++*piece;
   }
   return found;
+}
+
+// Throws when a <Piece> below e announces more points or cells than hexbite reads (2^31 - 1 of each): VTK
+// allocates what a piece announces before it reads the data, so a damaged count (10^15 points) ended in
+// std::bad_alloc and a "does not fit in memory" failure instead of naming the damage.
+void check_piece_counts(vtkXMLDataElement* e, const std::string& file) {
+  for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
+    vtkXMLDataElement* child = e->GetNestedElement(i);
+    const char* name = child->GetName();
+    if (name == nullptr) continue;
+    if (std::strcmp(name, "Piece") != 0) {
+      check_piece_counts(child, file);
+      continue;
+    }
+    for (const char* count : {"NumberOfPoints", "NumberOfCells", "NumberOfVerts", "NumberOfLines",
+                              "NumberOfStrips", "NumberOfPolys"}) {
+      const char* value = child->GetAttribute(count);
+      if (value == nullptr) continue;
+      errno = 0;
+      const long long n = std::strtoll(value, nullptr, 10);
+      if (n > std::numeric_limits<int>::max() || errno == ERANGE)
+        throw InputError("cannot read '" + file + "': its <Piece> announces " + count + "=\"" + value +
+                         "\", more than the 2^31 - 1 that hexbite reads; the file is damaged (check the "
+                         "counts in its <Piece> element) or too large for hexbite");
+    }
+  }
 }
 
 // The file's text with an empty <PointData> before each <CellData> of its XML part (offsets into an
@@ -161,7 +190,10 @@ void update_xml_reader(vtkXMLReader* reader, const std::string& file) {
     if (!unnamed.empty())
       throw InputError("cannot read '" + file + "': a data array in its " + unnamed +
                        " has no Name attribute; the file is damaged, or its writer left the name out");
-    if (root != nullptr) disable_string_arrays(root, reader);
+    if (root != nullptr) {
+      check_piece_counts(root, file);
+      disable_string_arrays(root, reader);
+    }
     reader->Update();
   } catch (const std::bad_alloc&) {
     // VTK allocates what the header announces before it reads the data.

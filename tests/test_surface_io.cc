@@ -436,6 +436,18 @@ TEST(SurfaceIoErrors, OutOfRangeIndices) {
   expect_input_error([&] { read_surface(dir + "/e.ply"); }, {"face 0", "vertex 7", "out of range"});
 }
 
+// Binary bytes in a text line are shown as \xNN: a NUL byte cut the message there (what() is a C string), and
+// the advice after the quoted line was lost.
+TEST(SurfaceIoErrors, BinaryBytesInALineKeepTheMessageWhole) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/a.obj", std::string("v 0 0 0\nv 0 0 \0\x01x 0\n", 20));
+  expect_input_error(
+      [&] { read_surface(dir + "/a.obj"); },
+      {"line 2", "malformed OBJ vertex line 'v 0 0 \\x00\\x01x 0'", "export the surface again"});
+  EXPECT_EQ(InputError(std::string("a\0b\x7f\nc\td\xc3\xa9", 10)).what(),
+            std::string("a\\x00b\\x7f\nc\td\xc3\xa9"));
+}
+
 TEST(SurfaceIoErrors, MalformedLines) {
   const std::string dir = temp_dir();
   write_file(dir + "/a.obj", "v 0 0 0\nv 1 0\n");
