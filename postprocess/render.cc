@@ -219,8 +219,8 @@ void render_surface_png(const TriSurface& surface, const std::string& png_path,
   render_actor_png(actor, nullptr, png_path, options);
 }
 
-void render_mesh_png(const std::string& vtu_path, const std::string& field, const std::string& png_path,
-                     const RenderOptions& options) {
+RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& field,
+                             const std::string& png_path, const RenderOptions& options) {
   if (!std::filesystem::is_regular_file(vtu_path))
     throw InputError("cannot read '" + vtu_path + "': no such file");
   // A .pvtu (the pieces of a run under mpirun) is read whole: its pieces appended into one grid. The nodes
@@ -245,6 +245,8 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
                        (pieces ? ".pvtu and its pieces" : ".vtu") + ") with cells" + capture.reason());
   }
 
+  RenderedMesh drawn;
+  drawn.cells = static_cast<long>(grid->GetNumberOfCells());
   vtkNew<vtkDataSetSurfaceFilter> outer;  // only the boundary faces are visible
   outer->SetInputData(grid);
   vtkNew<vtkPolyDataMapper> mapper;
@@ -257,7 +259,7 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
     mapper->ScalarVisibilityOff();
     actor->GetProperty()->SetColor(0.93, 0.89, 0.80);
     render_actor_png(actor, nullptr, png_path, options);
-    return;
+    return drawn;
   }
   // A point array (a solution field such as von_mises), else a cell array (the per-hex quality arrays that
   // hexbite mesh, refine and reorder write, such as scaled_jacobian): each hex's face in its colour.
@@ -276,6 +278,7 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
   const int component = array->GetNumberOfComponents() == 1 ? 0 : -1;  // -1: magnitude
   double range[2];
   array->GetRange(range, component);
+  drawn.field_max = range[1];
   // Stress peaks at the edges of fixed patches would wash out the rest of the picture: let the caller
   // cap the scale (values above it show in the top colour).
   if (options.colour_max > 0) {
@@ -309,6 +312,7 @@ void render_mesh_png(const std::string& vtu_path, const std::string& field, cons
   bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
   bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
   render_actor_png(actor, bar, png_path, options);
+  return drawn;
 }
 
 }  // namespace hexbite

@@ -24,11 +24,19 @@ std::string display_problem();
 // Renders the triangle surface and writes a PNG atomically. Throws RunError when no display.
 void render_surface_png(const TriSurface& surface, const std::string& png_path, const RenderOptions& options);
 
+// What render_mesh_png drew: the file's cell count and the field's largest value (vector arrays: magnitude;
+// 0 for an empty field), before any cap of the colour scale, so that callers can tell that a file belongs
+// to the figures they print beside it.
+struct RenderedMesh {
+  long cells = 0;
+  double field_max = 0;
+};
+
 // Renders the outer surface of a hex mesh file (VTU, or a PVTU with its pieces) coloured by a point array
 // (e.g. "von_mises" of a solution.vtu; vector arrays by their magnitude) with a colour bar, and writes a PNG
 // atomically. An empty field draws the mesh in bone colour. Throws InputError naming the file for an
 // unreadable VTU or an unknown array (listing the available ones), RunError when there is no display.
-void render_mesh_png(const std::string& vtu_path, const std::string& field, const std::string& png_path,
-                     const RenderOptions& options);
+RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& field,
+                             const std::string& png_path, const RenderOptions& options);
 
 }  // namespace hexbite

@@ -2,6 +2,8 @@
 
 #include <stdlib.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -44,6 +46,25 @@ std::string read_bytes(const std::string& path) {
   return bytes.str();
 }
 
+// The pictures must show the run whose figures the report prints: a solution.vtu left from another run (a
+// results.json copied or restored beside it) was drawn without a word. Its hex count, and the largest
+// displacement, must be the coarse level's (to 1e-4: an MPI run's pieces hold single-precision values).
+void check_same_run(const std::string& solution_vtu, const RenderedMesh& drawn, const std::string& field,
+                    const LevelFigures& l) {
+  std::string differs;
+  if (drawn.cells != l.hexes)
+    differs = "has " + std::to_string(drawn.cells) + " hexes where results.json's coarse level has " +
+              std::to_string(l.hexes);
+  else if (field == "displacement" &&
+           std::abs(drawn.field_max - l.max_displacement) > 1e-4 * std::max(l.max_displacement, 1e-12))
+    differs = "has a largest displacement of " + format_mm(drawn.field_max) +
+              " mm where results.json's coarse level has " + format_mm(l.max_displacement) + " mm";
+  if (!differs.empty())
+    throw InputError("'" + solution_vtu + "' " + differs +
+                     ": it is not the solution of the run that results.json describes; run the scenario "
+                     "again into this folder, or add --no-pictures");
+}
+
 }  // namespace
 
 std::vector<ReportPicture> render_report_pictures(const std::string& solution_vtu, const RunFigures& run) {
@@ -77,7 +98,8 @@ std::vector<ReportPicture> render_report_pictures(const std::string& solution_vt
     options.height = 800;
     options.colour_max = s.colour_max;
     const std::string png = folder.path() + "/" + s.field + "_" + s.view + ".png";
-    render_mesh_png(solution_vtu, s.field, png, options);
+    const RenderedMesh drawn = render_mesh_png(solution_vtu, s.field, png, options);
+    check_same_run(solution_vtu, drawn, s.field, l);
     pictures.push_back({s.field, s.view, s.caption, read_bytes(png)});
   }
   return pictures;

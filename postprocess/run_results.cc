@@ -110,11 +110,10 @@ QualityFigures quality(const Checked& c, const Key& q, const std::string& measur
 LevelFigures level_figures(const Checked& c, const Key& l, const std::vector<std::string>& support_order) {
   LevelFigures f;
   const Key reactions = c.child(l, "reactions");
-  // results.json keeps the reactions in an object (sorted by name); the scenario's order reads better.
-  std::vector<std::string> names;
-  for (const std::string& name : support_order)
-    if (c.object(reactions).contains(name)) names.push_back(name);
-  for (const auto& item : reactions.value.items())
+  // results.json keeps the reactions in an object (sorted by name); the scenario's order reads better. Every
+  // support of the model has one (a missing one, from an edited file, was left out of the report silently).
+  std::vector<std::string> names = support_order;
+  for (const auto& item : c.object(reactions).items())
     if (std::find(names.begin(), names.end(), item.key()) == names.end()) names.push_back(item.key());
   for (const std::string& name : names) {
     const Key r = c.child(reactions, name);

@@ -324,6 +324,8 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   no_key["validation"]["levels"][1].erase("hexes");
   json wrong_type = *results_;
   wrong_type["bite_force_N"] = "367.0";
+  json no_reaction = *results_;  // the report left the support out without a word
+  no_reaction["reactions"].erase("floor_rest");
   const std::string cut = results.substr(0, results.find("\"mesh\""));  // ends inside the object
   const int cut_line = static_cast<int>(count(cut, "\n")) + 1;
   write_file(dir + "/a_file", "x");
@@ -349,6 +351,8 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
        "key 'validation.levels[1].hexes' is missing"},
       {{"report", folder_with("wrong_type", wrong_type.dump(1)), "-o", out, "--no-pictures"},
        "key 'bite_force_N' is a string, expected a number or null"},
+      {{"report", folder_with("no_reaction", no_reaction.dump(1)), "-o", out, "--no-pictures"},
+       "key 'reactions.floor_rest' is missing"},
       {{"report", folder_with("no_vtu", results), "-o", out}, "`outputs: {vtu: false}`"},
       {{"report", folder_with("no_vtu2", results), "-o", out}, "add --no-pictures"},
       {{"report", *run_dir_, "-o", dir + "/r.txt"}, "this command writes .html or .htm"},
@@ -372,6 +376,31 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   // The not-JSON case says what is wrong at that line.
   EXPECT_NE(run_hexbite({"report", dir + "/cut", "-o", out, "--no-pictures"}).err.find("not JSON"),
             std::string::npos);
+}
+
+// The pictures are of the run whose figures the report prints: a solution.vtu beside another run's
+// results.json (a different mesh, or the same mesh with other loads) was drawn without a word.
+TEST_F(Report, PicturesOfAnotherRunAreRefused) {
+  const std::string dir = temp_dir(), out = dir + "/r.html";
+  json other_mesh = *results_, other_loads = *results_;
+  other_mesh["mesh"]["hexes"] = (*results_)["mesh"]["hexes"].get<long>() + 8;
+  other_loads["max_displacement_mm"] = (*results_)["max_displacement_mm"].get<double>() * 1.5;
+  const std::vector<std::pair<json, std::string>> cases = {
+      {other_mesh, "hexes where results.json's coarse level has"},
+      {other_loads, "has a largest displacement of"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string folder = dir + "/run" + std::to_string(i);
+    fs::create_directories(folder);
+    fs::copy_file(*run_dir_ + "/solution.vtu", folder + "/solution.vtu");
+    write_file(folder + "/results.json", cases[i].first.dump(1));
+    const test::CommandResult r = run_hexbite({"report", folder, "-o", out}, display_launcher());
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(cases[i].second), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("it is not the solution of the run that results.json describes"), std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 // Under mpirun the solution is written in pieces (solution.pvtu): the report draws its pictures from them
