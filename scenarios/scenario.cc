@@ -651,16 +651,23 @@ void check_poisson_for_degree(const Scenario& s) {
                "Poisson's ratio above " + fmt(kMaxPoissonQ1) + ", or use at most " + fmt(kMaxPoissonQ1));
 }
 
+// A list's place for messages about the whole list: its key's, or in a study's variant that set the list
+// (`set: {supports: []}`) the study's line, where the list was written.
+SourceLocation list_at(const Map& root, const std::string& key) {
+  const Value& v = root.get(key);
+  return !v.node.IsNull() && v.at.file != root.key_at(key).file ? v.at : root.key_at(key);
+}
+
 // Checks that can be made before the geometry exists: something loads the bone, something holds it.
 void check_loads_and_supports(const Scenario& s, const Map& root) {
-  const SourceLocation muscles_at = root.has("muscles")              ? root.key_at("muscles")
-                                    : root.has("activation_pattern") ? root.key_at("activation_pattern")
+  const SourceLocation muscles_at = root.has("muscles")              ? list_at(root, "muscles")
+                                    : root.has("activation_pattern") ? list_at(root, "activation_pattern")
                                                                      : root.at();
   if (std::none_of(s.muscles.begin(), s.muscles.end(), [](const Muscle& m) { return m.activation > 0; }))
     fail(muscles_at,
          "no muscle is active, so nothing loads the mandible; give at least one muscle an activation "
          "above 0 in 'muscles' or 'activation_pattern'");
-  const SourceLocation supports_at = root.has("supports") ? root.key_at("supports") : root.at();
+  const SourceLocation supports_at = root.has("supports") ? list_at(root, "supports") : root.at();
   if (s.supports.empty())
     fail(supports_at,
          "the scenario has no supports: nothing holds the mandible, so it could move as a rigid body "

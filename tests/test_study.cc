@@ -262,6 +262,12 @@ TEST(Study, InvalidOverriddenValueIsNamedAtTheStudysLine) {
                  "variant 'soft': materials.default.E_MPa is -5 MPa but Young's modulus must be positive");
 }
 
+// An empty list the study set is named at the study's line (it was named at the base's `supports:` key).
+TEST(Study, AnEmptyListTheStudySetIsNamedAtTheStudysLine) {
+  expect_refused(soft_setting("supports: []"), 7, "the scenario has no supports");
+  expect_refused(soft_setting("muscles: []"), 7, "no muscle is active");
+}
+
 // A point name is checked once the geometry exists, still before the first solve of any variant.
 TEST(Study, UnknownPointOfTheLastVariantStopsTheStudyBeforeAnySolve) {
   std::string study = kStudy + "  - name: lost\n    set:\n      supports.base.at: nowhere\n";
