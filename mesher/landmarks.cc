@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/number_format.h"
+#include "common/suggestion.h"
 #include "mesher/surface_projector.h"
 #include "mesher/units.h"
 
@@ -19,10 +20,11 @@ namespace hexbite {
 
 namespace {
 
-// Every message names the file and the 1-based line so that a user can go straight to the mistake.
+// Every message names the file and the 1-based line and column (as the scenario's messages do) so that a
+// user can go straight to the mistake.
 [[noreturn]] void fail(const std::string& path, const YAML::Mark& mark, const std::string& what) {
   std::string where = path;
-  if (!mark.is_null()) where += ":" + std::to_string(mark.line + 1);
+  if (!mark.is_null()) where += ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
   throw InputError("landmark file " + where + ": " + what);
 }
 
@@ -102,7 +104,8 @@ void read_muscle(const std::string& path, const YAML::Node& node, double scale, 
       has[3] = true;
     } else {
       fail(path, kv.first.Mark(),
-           "unknown muscle key '" + key + "' (expected name, max_force_N, insertion, origin)");
+           "unknown muscle key '" + key + "'; " +
+               suggestion(key, {"name", "max_force_N", "insertion", "origin"}, "muscle keys"));
     }
   }
   static const char* const kKeys[4] = {"name", "max_force_N", "insertion", "origin"};
@@ -177,11 +180,10 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
         for (const auto& m : value) read_muscle(path, m, scale_to_mm, out, names);
       } else {
         fail(path, kv.first.Mark(),
-             "unknown section '" + key + "' (expected 'landmarks' and 'muscles')" +
-                 (key == "units"
-                      ? "; the file's unit is given where it is read: a scenario's landmarks.units, "
-                        "or --units"
-                      : ""));
+             "unknown section '" + key + "'; " +
+                 (key == "units" ? "the file's unit is given where it is read: a scenario's landmarks.units, "
+                                   "or --units"
+                                 : suggestion(key, {"landmarks", "muscles"}, "sections")));
       }
     }
   } catch (const YAML::Exception& e) {

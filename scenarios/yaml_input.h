@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "common/suggestion.h"
 #include "scenarios/scenario.h"
 
 namespace hexbite::yaml_input {
@@ -44,17 +45,6 @@ struct Source {
 };
 
 [[noreturn]] void fail(const SourceLocation& where, const std::string& message);
-
-std::string quote(const std::string& s);
-std::string join_quoted(const std::vector<std::string>& items);
-
-// The number of single-character insertions, deletions and substitutions that turn `a` into `b`.
-size_t edit_distance(const std::string& a, const std::string& b);
-
-// "did you mean 'x'?" when a valid choice is within a few edits (typos), else "valid <noun> are ..." with
-// the whole list, so that the message always says what to write instead.
-std::string suggestion(const std::string& given, const std::vector<std::string>& valid,
-                       const std::string& noun = "choices");
 
 // A YAML node with its tree's Source, where it was written and its path in the document
 // ("muscles[2].activation").

@@ -350,25 +350,27 @@ void expect_landmark_error(const std::string& contents, const std::string& expec
   }
 }
 
-TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
-  expect_landmark_error("landmarks:\n  a: [1, 2]\n", ":2: landmark 'a' must be a list of three");
-  expect_landmark_error("landmarks:\n  a: [1, 2, x]\n", ":2: landmark 'a' coordinate must be a number");
+TEST(Landmarks, MalformedFilesNameTheFileLineAndColumn) {
+  expect_landmark_error("landmarks:\n  a: [1, 2]\n", ":2:6: landmark 'a' must be a list of three");
+  expect_landmark_error("landmarks:\n  a: [1, 2, x]\n", ":2:13: landmark 'a' coordinate must be a number");
   expect_landmark_error("landmarks: {a: [1, 2, 3]\n", "not valid YAML");
   expect_landmark_error("muscles:\n  - {name: m, max_force_N: 1, insertion: [0, 0, 0]}\n",
-                        ":2: muscle 'm' has no 'origin'");
+                        ":2:5: muscle 'm' has no 'origin'");
   expect_landmark_error("muscles:\n  - {name: m, max_force_N: -1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
                         "must not be negative");
-  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n", ":3: unknown section 'muscle'");
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n", ":3:1: unknown section 'muscle'; did you mean 'muscles'?");
   expect_landmark_error("units: cm\nlandmarks:\n  a: [1, 2, 3]\n",
-                        ":1: unknown section 'units' (expected "
-                        "'landmarks' and 'muscles'); the file's unit is given where it is read: a scenario's "
+                        ":1:1: unknown section 'units'; the file's unit is given where it is read: a scenario's "
                         "landmarks.units, or --units");
+  // A mistyped muscle key gets the key it is a typo of (it listed the four keys only).
+  expect_landmark_error("muscles:\n  - {name: m, max_force: 1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
+                        ":2:15: unknown muscle key 'max_force'; did you mean 'max_force_N'?");
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  a: [1, 2, 4]\n",
                         ":3: name 'a' is given twice (first on line 2)");
   expect_landmark_error("", "is empty");
   // yaml-cpp alone says "bad conversion" for a list used as a name.
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  ? [x, y]\n  : [1, 2, 3]\n",
-                        ":3: expected a name (a plain word) as the key");
+                        ":3:5: expected a name (a plain word) as the key");
   EXPECT_THROW(read_landmarks(test::temp_dir() + "/missing.yaml"), InputError);
   // A folder was read as a stream and failed with a std::ios exception (exit 1, no file named).
   const std::string folder = test::temp_dir() + "/landmarks.yaml";
@@ -385,26 +387,26 @@ TEST(Landmarks, MalformedFilesNameTheFileAndLine) {
 // 1e9 N; a coordinate in range could also overflow to infinity when scaled to millimetres.
 TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
   expect_landmark_error("landmarks:\n  a: [1, 2, 3]\n  b: [0, 1e300, 0]\n",
-                        ":3: landmark 'b' coordinate is 1e+300, beyond 1e+06 mm in size");
+                        ":3:10: landmark 'b' coordinate is 1e+300, beyond 1e+06 mm in size");
   expect_landmark_error("landmarks:\n  a: [-2000000, 0, 0]\n",
-                        ":2: landmark 'a' coordinate is -2e+06, beyond");
-  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n", ":2: landmark 'a' coordinate is not finite");
-  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n", ":2: landmark 'a' coordinate is not finite");
+                        ":2:7: landmark 'a' coordinate is -2e+06, beyond");
+  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n", ":2:7: landmark 'a' coordinate is not finite");
+  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n", ":2:13: landmark 'a' coordinate is not finite");
   expect_landmark_error(
       "muscles:\n  - {name: m, max_force_N: 1,\n     insertion: [0, 0, 0],\n     origin: [0, 0, 1e7]}\n",
-      ":4: muscle 'm' origin coordinate is 1e+07, beyond 1e+06 mm in size");
+      ":4:21: muscle 'm' origin coordinate is 1e+07, beyond 1e+06 mm in size");
   expect_landmark_error(
       "muscles:\n  - {name: m, max_force_N: 1, insertion: [0, 1e300, 0], origin: [0, 0, 1]}\n",
-      ":2: muscle 'm' insertion coordinate is 1e+300, beyond");
+      ":2:46: muscle 'm' insertion coordinate is 1e+300, beyond");
   expect_landmark_error(
       "muscles:\n  - {name: m, max_force_N: 1e9, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
-      ":2: muscle 'm' max_force_N is 1e+09 N, more than 10000 N");
+      ":2:28: muscle 'm' max_force_N is 1e+09 N, more than 10000 N");
   // In range in the file's unit, beyond it in millimetres.
   const std::string path = test::temp_dir() + "/m.yaml";
   test::write_file(path, "landmarks:\n  a: [0, 0, 5000]\n");
   const std::string scaled =
       test::message_of<InputError>([&] { read_landmarks(path, /*scale_to_mm=*/1000.0); });
-  EXPECT_NE(scaled.find(path + ":2: landmark 'a' coordinate is 5e+06 mm (5000 in the file's unit), beyond"),
+  EXPECT_NE(scaled.find(path + ":2:13: landmark 'a' coordinate is 5e+06 mm (5000 in the file's unit), beyond"),
             std::string::npos)
       << scaled;
   // The bounds themselves are accepted.
