@@ -358,10 +358,12 @@ TEST(Landmarks, MalformedFilesNameTheFileLineAndColumn) {
                         ":2:5: muscle 'm' has no 'origin'");
   expect_landmark_error("muscles:\n  - {name: m, max_force_N: -1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
                         "must not be negative");
-  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n", ":3:1: unknown section 'muscle'; did you mean 'muscles'?");
-  expect_landmark_error("units: cm\nlandmarks:\n  a: [1, 2, 3]\n",
-                        ":1:1: unknown section 'units'; the file's unit is given where it is read: a scenario's "
-                        "landmarks.units, or --units");
+  expect_landmark_error("landmarks:\n  a: [1, 2, 3]\nmuscle:\n  - {}\n",
+                        ":3:1: unknown section 'muscle'; did you mean 'muscles'?");
+  expect_landmark_error(
+      "units: cm\nlandmarks:\n  a: [1, 2, 3]\n",
+      ":1:1: unknown section 'units'; the file's unit is given where it is read: a scenario's "
+      "landmarks.units, or --units");
   // A mistyped muscle key gets the key it is a typo of (it listed the four keys only).
   expect_landmark_error("muscles:\n  - {name: m, max_force: 1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
                         ":2:15: unknown muscle key 'max_force'; did you mean 'max_force_N'?");
@@ -406,8 +408,9 @@ TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
   test::write_file(path, "landmarks:\n  a: [0, 0, 5000]\n");
   const std::string scaled =
       test::message_of<InputError>([&] { read_landmarks(path, /*scale_to_mm=*/1000.0); });
-  EXPECT_NE(scaled.find(path + ":2:13: landmark 'a' coordinate is 5e+06 mm (5000 in the file's unit), beyond"),
-            std::string::npos)
+  EXPECT_NE(
+      scaled.find(path + ":2:13: landmark 'a' coordinate is 5e+06 mm (5000 in the file's unit), beyond"),
+      std::string::npos)
       << scaled;
   // The bounds themselves are accepted.
   test::write_file(path,
