@@ -37,7 +37,10 @@ json level_figures(const Scenario& s, const LevelResult& l) {
   const ElasticitySolution& u = l.solution;
   json reactions = json::object();
   for (const SupportReaction& r : u.reactions)
-    reactions[r.name] = {{"force_N", vec(r.force)}, {"magnitude_N", r.magnitude}, {"bite", r.is_bite}};
+    reactions[r.name] = {{"force_N", vec(r.force)},
+                         {"magnitude_N", r.magnitude},
+                         {"bite", r.is_bite},
+                         {"released", r.released}};
   json probes = json::object();
   for (std::size_t i = 0; i < s.probes.size(); ++i) {
     const ProbeValue& p = u.probes[i];
@@ -137,10 +140,16 @@ void write_inp_deck(const RunResult& r, const std::string& dir) {
         << format_inp_number(materials[k].poisson_ratio) << '\n'
         << "*SOLID SECTION, ELSET=" << name << ", MATERIAL=" << name << '\n';
   }
-  out << "** fixed supports (zero displacement in the fixed components)\n*BOUNDARY\n";
+  out << "** fixed supports (zero displacement in the fixed components)\n";
+  // The deck is of the solved state: a contact released at level 0 (it would pull the bone) is left out.
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    if (l.solution.reactions[i].released)
+      out << "** contact " << s.supports[i].name << " released: it would pull the bone\n";
+  out << "*BOUNDARY\n";
   for (std::size_t i = 0; i < s.supports.size(); ++i)
     for (int d = 0; d < 3; ++d)
-      if (s.supports[i].fixed[d]) out << node_sets[i].name << ", " << d + 1 << ", " << d + 1 << '\n';
+      if (s.supports[i].fixed[d] && !l.solution.reactions[i].released)
+        out << node_sets[i].name << ", " << d + 1 << ", " << d + 1 << '\n';
   out << "*STEP\n*STATIC\n** muscle loads: consistent nodal forces of the uniform tractions\n*CLOAD\n";
   for (const auto& [node, f] : loads)
     for (int d = 0; d < 3; ++d)
@@ -360,6 +369,7 @@ json results_json(const RunResult& r, double seconds_output) {
                         {"fixed", fixed},
                         {"spring_N_per_mm3", sup.spring_N_per_mm3 ? json(*sup.spring_N_per_mm3) : json()},
                         {"bite", sup.bite},
+                        {"contact", sup.contact},
                         {"patch_area_mm2", coarse.support_patches[i].area_mm2},
                         {"facets", coarse.support_patches[i].faces.size()}});
   }
@@ -547,6 +557,15 @@ std::string summary_table(const RunResult& r) {
   for (std::size_t i = 0; i < r.scenario.supports.size(); ++i) {
     const std::string label = "reaction " + r.scenario.supports[i].name + " (N)";
     figure_row(label.c_str(), 2, [i](const LevelResult& l) { return l.solution.reactions[i].magnitude; });
+  }
+  // A released contact's row reads 0; say why, and at which levels.
+  for (std::size_t i = 0; i < r.scenario.supports.size(); ++i) {
+    std::string levels;
+    for (const LevelResult& l : r.levels)
+      if (l.solution.reactions[i].released) levels += (levels.empty() ? "" : ", ") + std::to_string(l.level);
+    if (!levels.empty())
+      out << "  (contact " << r.scenario.supports[i].name << " released at level " << levels
+          << ": it would pull the bone)\n";
   }
   figure_row("max displacement (mm)", 5, [](const LevelResult& l) { return l.solution.max_displacement; });
   figure_row("von Mises max (MPa)", 3, [](const LevelResult& l) { return l.solution.von_mises_max; });

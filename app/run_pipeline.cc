@@ -11,6 +11,7 @@
 #include <set>
 #include <string>
 
+#include "app/contact_supports.h"
 #include "app/rigid_support.h"
 #include "common/error.h"
 #include "common/progress.h"
@@ -629,6 +630,26 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
   return modes;
 }
 
+// Without the released contacts, some support must still hold each of x, y and z (as the scenario's own
+// check asks of all of them): else the loads lift the bone off its contacts and nothing holds it.
+void check_held_without_released(const Scenario& s, const std::vector<bool>& released, int level) {
+  std::string loose, names;
+  for (int axis = 0; axis < 3; ++axis) {
+    bool held = false;
+    for (std::size_t i = 0; i < s.supports.size(); ++i)
+      held = held || (!released[i] && (s.supports[i].spring_N_per_mm3 || s.supports[i].fixed[axis]));
+    if (!held) loose += std::string(loose.empty() ? "" : ", ") + "xyz"[axis];
+  }
+  if (loose.empty()) return;
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    if (released[i]) names += (names.empty() ? "'" : ", '") + s.supports[i].name + "'";
+  throw RunError(
+      s.supports.front().where.str() + ": level " + std::to_string(level) + ": the contact " + names +
+      " would pull the bone, and without it no support holds it along " + loose +
+      ": the loads lift the bone off its contacts; check the muscles' directions, or hold the bone "
+      "with a support that is not a contact");
+}
+
 void solve_level(const Scenario& s, LevelResult& r) {
   ElasticityProblem p;
   p.mesh = &r.mesh;
@@ -665,22 +686,54 @@ void solve_level(const Scenario& s, LevelResult& r) {
   p.solver.relative_tolerance = s.solver.tolerance;
   p.solver.max_iterations = s.solver.max_iterations;
 
-  Progress progress("solve level " + std::to_string(r.level));
+  // One-sided contacts: solved held, released where they would pull, and solved again until the set
+  // settles (app/contact_supports.h); a set seen before would cycle.
+  const std::vector<SupportPatch> all_supports = std::move(p.supports);
+  std::vector<bool> released(s.supports.size(), false);
+  std::vector<Vec3> directions(s.supports.size(), Vec3{0, 0, 0});
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    if (s.supports[i].contact) directions[i] = contact_direction(s.supports[i], r.support_patches[i], r.mesh);
+  std::set<std::vector<bool>> seen;
   const auto start = std::chrono::steady_clock::now();
-  try {
-    r.solution = solve_elasticity(p);
-  } catch (const RunError& e) {
-    // The solver speaks of its own options: name the level and the scenario's settings.
-    char settings[160];
-    std::snprintf(settings, sizeof settings,
-                  "; the scenario's solver.max_iterations is %d, solver.tolerance %g",
-                  s.solver.max_iterations, s.solver.tolerance);
-    throw RunError((s.solver.where.line ? s.solver.where.str() : s.path) + ": level " +
-                   std::to_string(r.level) + " (" + std::to_string(dofs) +
-                   " degrees of freedom): " + e.what() + settings);
+  for (;;) {
+    seen.insert(released);
+    p.supports.clear();
+    for (std::size_t i = 0; i < s.supports.size(); ++i)
+      if (!released[i]) p.supports.push_back(all_supports[i]);
+    check_held_without_released(s, released, r.level);
+    Progress progress("solve level " + std::to_string(r.level));
+    try {
+      r.solution = solve_elasticity(p);
+    } catch (const RunError& e) {
+      // The solver speaks of its own options: name the level and the scenario's settings.
+      char settings[160];
+      std::snprintf(settings, sizeof settings,
+                    "; the scenario's solver.max_iterations is %d, solver.tolerance %g",
+                    s.solver.max_iterations, s.solver.tolerance);
+      throw RunError((s.solver.where.line ? s.solver.where.str() : s.path) + ": level " +
+                     std::to_string(r.level) + " (" + std::to_string(dofs) +
+                     " degrees of freedom): " + e.what() + settings);
+    }
+    progress.finish(std::to_string(r.solution.dofs) + " DoFs");
+    // The reactions in the scenario's order, the released contacts' zero.
+    std::vector<SupportReaction> reactions;
+    for (std::size_t i = 0, k = 0; i < s.supports.size(); ++i)
+      reactions.push_back(released[i]
+                              ? SupportReaction{s.supports[i].name, s.supports[i].bite, {0, 0, 0}, 0, true}
+                              : r.solution.reactions[k++]);
+    r.solution.reactions = std::move(reactions);
+    const std::vector<bool> before = released;
+    if (!update_released_contacts(s.supports, r.support_patches, directions, r.solution, released)) break;
+    for (std::size_t i = 0; i < s.supports.size(); ++i)
+      if (released[i] != before[i])
+        info("level " + std::to_string(r.level) + ": contact '" + s.supports[i].name +
+             (released[i] ? "' would pull the bone: released" : "' touches again: held") + ", solving again");
+    if (seen.count(released) != 0)
+      throw RunError(s.supports.front().where.str() + ": level " + std::to_string(r.level) +
+                     ": the contact supports do not settle (releasing those that pull makes others pull, "
+                     "and back): fix them (remove 'contact') or move their patches");
   }
   r.seconds_solve = seconds_since(start);
-  progress.finish(std::to_string(r.solution.dofs) + " DoFs");
 }
 
 }  // namespace

@@ -163,6 +163,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
       condition = "fixed";
       for (std::size_t i = 0; i < s.fixed->size(); ++i)
         condition += (i == 0 ? " " : ", ") + html_escape((*s.fixed)[i]);
+      if (s.contact) condition += " (contact: pushes only)";
     }
     char radius[32];
     std::snprintf(radius, sizeof radius, "%g", s.radius_mm.value_or(0));
@@ -199,9 +200,9 @@ void results_section(std::ostringstream& out, const RunFigures& r) {
   t.header({text("support"), text("bite"), num("F<sub>x</sub> (N)"), num("F<sub>y</sub> (N)"),
             num("F<sub>z</sub> (N)"), num("|F| (N)")});
   for (const ReactionFigures& s : l.reactions)
-    t.row({text(html_escape(s.name)), text(s.bite ? "yes" : "no"), num(format_newtons(s.force[0])),
-           num(format_newtons(s.force[1])), num(format_newtons(s.force[2])),
-           num(format_newtons(s.magnitude))});
+    t.row({text(html_escape(s.name) + (s.released ? " (contact released: it would pull the bone)" : "")),
+           text(s.bite ? "yes" : "no"), num(format_newtons(s.force[0])), num(format_newtons(s.force[1])),
+           num(format_newtons(s.force[2])), num(format_newtons(s.magnitude))});
 }
 
 void validation_section(std::ostringstream& out, const RunFigures& r) {

@@ -117,8 +117,10 @@ LevelFigures level_figures(const Checked& c, const Key& l, const std::vector<std
     if (std::find(names.begin(), names.end(), item.key()) == names.end()) names.push_back(item.key());
   for (const std::string& name : names) {
     const Key r = c.child(reactions, name);
-    f.reactions.push_back(
-        {name, c.vec(r, "force_N"), c.number(r, "magnitude_N"), c.boolean(c.child(r, "bite"))});
+    // `released` came with contact supports; a results.json of an older hexbite has none.
+    f.reactions.push_back({name, c.vec(r, "force_N"), c.number(r, "magnitude_N"),
+                           c.boolean(c.child(r, "bite")),
+                           c.has(r, "released") && c.boolean(c.child(r, "released"))});
   }
   f.bite_force = c.number_or_null(c.child(l, "bite_force_N"));
   f.applied_force = c.vec(l, "applied_force_N");
@@ -173,6 +175,7 @@ void read_model(const Checked& c, const Key& top, RunFigures& r) {
         s.fixed.emplace();
         c.each(k, "fixed", [&](const Key& axis) { s.fixed->push_back(c.text(axis)); });
       }
+      s.contact = c.has(k, "contact") && c.boolean(c.child(k, "contact"));
       s.patch_area_mm2 = c.number(k, "patch_area_mm2");
       r.supports.push_back(s);
     });

@@ -20,6 +20,7 @@ struct ReactionFigures {
   Vec3 force{0, 0, 0};  // N, the force the support exerts on the bone
   double magnitude = 0;
   bool bite = false;
+  bool released = false;  // a contact that would have pulled the bone, left out of the solve
 };
 
 struct ProbeFigures {
@@ -91,6 +92,7 @@ struct SupportFigures {
   std::optional<Vec3> center;  // mm
   std::optional<double> radius_mm, spring_N_per_mm3;
   std::optional<std::vector<std::string>> fixed;  // the fixed components, "x" "y" "z"
+  bool contact = false;                           // one-sided: pushes the bone, never pulls
   double patch_area_mm2 = 0;
 };
 

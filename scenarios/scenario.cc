@@ -543,7 +543,7 @@ std::vector<Muscle> parse_activation_pattern(const Source& ctx, const Value& v) 
 }
 
 Support parse_support(const Value& item) {
-  const Map map(item, {"name", "at", "radius_mm", "fixed", "spring_N_per_mm3", "bite"});
+  const Map map(item, {"name", "at", "radius_mm", "fixed", "spring_N_per_mm3", "bite", "contact"});
   Support s;
   s.where = item.at;
   s.name = to_string(map.require("name", "name: right_condyle"));
@@ -574,6 +574,11 @@ Support parse_support(const Value& item) {
         positive(*x, "the foundation stiffness in N/mm^3 (traction per displacement), e.g. 50");
   }
   if (auto x = map.find("bite")) s.bite = to_bool(*x);
+  if (auto x = map.find("contact")) s.contact = to_bool(*x);
+  if (s.contact && s.spring_N_per_mm3)
+    fail(map.key_at("contact"), "support " + quote(s.name) +
+                                    " is a spring and a contact; a contact is a fixed patch that only "
+                                    "pushes: remove 'contact' or 'spring_N_per_mm3'");
   return s;
 }
 

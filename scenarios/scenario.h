@@ -138,6 +138,9 @@ struct Support {
   std::array<bool, 3> fixed{true, true, true};  // fixed displacement components x, y, z
   std::optional<double> spring_N_per_mm3;       // an elastic foundation instead of fixed components
   bool bite = false;  // the bite force is the magnitude of the summed reaction of the bite supports
+  // A one-sided contact (an antagonist tooth, a nut): it may push the bone but never pull it. A contact
+  // whose reaction would pull is released and the level solved again without it (run_pipeline.h).
+  bool contact = false;
   SourceLocation where;
 };
 

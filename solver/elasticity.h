@@ -86,6 +86,9 @@ struct SupportReaction {
   bool is_bite = false;
   Vec3 force{0.0, 0.0, 0.0};  // N, the force the support exerts on the bone
   double magnitude = 0.0;
+  // Set by a caller that left the support out of the solve (a one-sided contact that would pull the bone;
+  // app/run_pipeline.h); its force is then zero. The solver itself never sets it.
+  bool released = false;
 };
 
 struct ProbeValue {

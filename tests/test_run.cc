@@ -224,16 +224,83 @@ TEST(RunScenario, RightMolarClenchContactsCarryOnlyVerticalForce) {
       run_scenario(kScenarios + "right_molar_clench.yaml", test::temp_dir() + "/clench", {"--levels", "0"});
   expect_contract(r, 1);
   // The molar and premolar contacts fix z only: their reactions have no horizontal part, and the bite force
-  // is the summed vertical reaction.
+  // is the summed vertical reaction. They push the jaw down, never up: with this pattern the muscles lift
+  // the premolar off its antagonist (its fixed patch pulled with +26 N), so it is released.
   double vertical = 0;
   for (const char* name : {"right_first_molar", "right_premolar"}) {
     const Vec3 f = vec(r["reactions"][name]["force_N"]);
     EXPECT_EQ(f[0], 0.0) << name;
     EXPECT_EQ(f[1], 0.0) << name;
+    EXPECT_LE(f[2], 0.0) << name;
     vertical += f[2];
   }
+  EXPECT_TRUE(r["reactions"]["right_premolar"]["released"].get<bool>());
+  EXPECT_FALSE(r["reactions"]["right_first_molar"]["released"].get<bool>());
   EXPECT_NEAR(r["bite_force_N"].get<double>(), std::abs(vertical), 1e-9 * std::abs(vertical));
   EXPECT_LT(vertical, -100.0);  // the teeth push the jaw down against the closing muscles
+}
+
+// A 20 mm cube clamped on its side at x = 0, pulled or pushed along z at the centre of its top face, with a
+// `floor` patch at the centre of its bottom face that fixes z, as a contact or as a plain support.
+std::string cube_on_a_floor(const std::string& pull_direction, const std::string& floor,
+                            bool clamp_z = true) {
+  return R"(name: floor_contact
+geometry:
+  surface: {file: cube.obj}
+mesh: {target_hexes: 500, validation_levels: 0}
+muscles:
+  - {name: pull, activation: 1, insertion: [10, 10, 20], radius_mm: 5, direction: )" +
+         pull_direction + R"(, max_force_N: 100}
+supports:
+  - {name: clamp, at: [0, 10, 10], radius_mm: 5, fixed: )" +
+         (clamp_z ? "[x, y, z]" : "[x, y]") + R"(}
+  - {name: floor, at: [10, 10, 0], radius_mm: 5, fixed: [z])" +
+         floor + R"(}
+outputs: {bite_force: false}
+)";
+}
+
+// Runs `scenario` on the cube into DIR/out (DIR a fresh folder, or `dir` when given); results.json.
+json run_cube(const std::string& scenario, std::vector<std::string> extra = {}, std::string dir = "") {
+  if (dir.empty()) dir = test::temp_dir();
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  test::write_file(dir + "/cube.yaml", scenario);
+  return run_scenario(dir + "/cube.yaml", dir + "/out", extra);
+}
+
+// A contact pushes but never pulls: a floor contact under a cube pulled up is released, and the run is the
+// run without it (a fixed floor held the cube down with a pull); under a cube pushed down it is held, and
+// the run is the run with a plain fixed floor.
+TEST(RunScenario, AContactThatWouldPullIsReleased) {
+  const std::string dir = test::temp_dir();
+  const json lifted = run_cube(cube_on_a_floor("[0, 0, 1]", ", contact: true"), {"--export", "inp"}, dir);
+  std::string no_floor = cube_on_a_floor("[0, 0, 1]", "");
+  const std::size_t floor = no_floor.find("  - {name: floor");
+  no_floor.erase(floor, no_floor.find("outputs:") - floor);
+  const json free = run_cube(no_floor);
+  const json held_down = run_cube(cube_on_a_floor("[0, 0, 1]", ""));
+  ASSERT_FALSE(lifted.is_null());
+  EXPECT_TRUE(lifted["reactions"]["floor"]["released"].get<bool>());
+  EXPECT_EQ(vec(lifted["reactions"]["floor"]["force_N"]), (Vec3{0, 0, 0}));
+  EXPECT_TRUE(lifted["supports"][1]["contact"].get<bool>());
+  for (const char* figure : {"max_displacement_mm", "strain_energy_mJ", "von_mises_max_MPa"})
+    EXPECT_NEAR(lifted[figure].get<double>(), free[figure].get<double>(), 1e-9 * free[figure].get<double>())
+        << figure;
+  // The plain fixed floor pulls the cube down, which is what a contact must not do.
+  EXPECT_LT(held_down["reactions"]["floor"]["force_N"][2].get<double>(), -1.0);
+  EXPECT_FALSE(held_down["reactions"]["floor"]["released"].get<bool>());
+  // The CalculiX deck is of the solved state: the released floor holds nothing there.
+  const std::string deck = test::read_file(dir + "/out/model.inp");
+  EXPECT_NE(deck.find("** contact floor released: it would pull the bone"), std::string::npos);
+  EXPECT_EQ(deck.find("SUP_FLOOR, 3, 3"), std::string::npos);
+  EXPECT_NE(deck.find("SUP_CLAMP, 3, 3"), std::string::npos);
+
+  const json pushed = run_cube(cube_on_a_floor("[0, 0, -1]", ", contact: true"));
+  const json fixed = run_cube(cube_on_a_floor("[0, 0, -1]", ""));
+  EXPECT_FALSE(pushed["reactions"]["floor"]["released"].get<bool>());
+  EXPECT_GT(pushed["reactions"]["floor"]["force_N"][2].get<double>(), 1.0);  // it pushes up
+  EXPECT_EQ(pushed["reactions"]["floor"]["force_N"], fixed["reactions"]["floor"]["force_N"]);
+  EXPECT_EQ(pushed["max_displacement_mm"], fixed["max_displacement_mm"]);
 }
 
 // Parses CalculiX's model.dat: the NODE PRINT displacements of set NALL and the total reaction force of
@@ -1067,6 +1134,35 @@ TEST(RunScenario, SpringSupportIsRefusedForTheCalculixExport) {
   std::string text = kSmall;
   text.replace(text.find("radius_mm: 6}"), 13, "radius_mm: 6, spring_N_per_mm3: 50}");
   expect_refused(text, "spring", {"--export", "inp"});
+}
+
+// A released contact that leaves a direction held by nothing stops the run (exit 1): the loads lift the
+// bone off its contacts. A contact that fixes only components along its own surface cannot push, and a
+// contact cannot be a spring (exit 2, at the support's line).
+TEST(RunScenario, ContactsThatCannotHoldAreRefused) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  test::write_file(dir + "/lifted.yaml", cube_on_a_floor("[0, 0, 1]", ", contact: true", false));
+  auto r = test::run_hexbite({"-q", "run", dir + "/lifted.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("the contact 'floor' would pull the bone, and without it no support holds it along z"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+
+  std::string sideways = cube_on_a_floor("[0, 0, 1]", ", contact: true");
+  sideways.replace(sideways.find("fixed: [z], contact"), 10, "fixed: [x]");
+  test::write_file(dir + "/sideways.yaml", sideways);
+  r = test::run_hexbite({"-q", "run", dir + "/sideways.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("sideways.yaml:9:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("contact support 'floor' fixes only components along its own surface"),
+            std::string::npos)
+      << r.err;
+
+  std::string spring = kSmall;
+  spring.replace(spring.find("radius_mm: 6}"), 13, "radius_mm: 6, spring_N_per_mm3: 50, contact: true}");
+  expect_refused(spring, "is a spring and a contact");
 }
 
 // The real jaw (../shared/data/jaw) in a right molar bite on a hard nut, both TMJ points fixed. 12,000

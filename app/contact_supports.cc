@@ -1,0 +1,72 @@
+#include "app/contact_supports.h"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "common/error.h"
+
+namespace hexbite {
+
+namespace {
+
+double dot(const Vec3& a, const Vec3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+}  // namespace
+
+Vec3 contact_direction(const Support& support, const MeshPatch& patch, const HexMesh& mesh) {
+  // Twice a bilinear quad's vector area is the cross product of its diagonals; the boundary quads are
+  // oriented outward (mesher/hex_boundary.h).
+  Vec3 n{0, 0, 0};
+  for (const BoundaryQuad& q : patch.faces) {
+    const Vec3& a = mesh.vertices[q[0]];
+    const Vec3& b = mesh.vertices[q[1]];
+    const Vec3& c = mesh.vertices[q[2]];
+    const Vec3& d = mesh.vertices[q[3]];
+    const Vec3 p{c[0] - a[0], c[1] - a[1], c[2] - a[2]}, r{d[0] - b[0], d[1] - b[1], d[2] - b[2]};
+    n[0] += p[1] * r[2] - p[2] * r[1];
+    n[1] += p[2] * r[0] - p[0] * r[2];
+    n[2] += p[0] * r[1] - p[1] * r[0];
+  }
+  const double length = std::sqrt(dot(n, n));
+  Vec3 held{0, 0, 0};
+  for (int d = 0; d < 3; ++d)
+    if (support.fixed[d] && length > 0) held[d] = n[d] / length;
+  if (!(std::sqrt(dot(held, held)) >= 0.1)) {
+    char faces[96];
+    std::snprintf(faces, sizeof faces, "(%.2f, %.2f, %.2f)", length > 0 ? n[0] / length : 0.0,
+                  length > 0 ? n[1] / length : 0.0, length > 0 ? n[2] / length : 0.0);
+    throw InputError(support.where.str() + ": contact support '" + support.name +
+                     "' fixes only components along its own surface (its patch faces " + faces +
+                     "), so it cannot push the bone: fix the component it faces, or remove 'contact'");
+  }
+  return held;
+}
+
+bool update_released_contacts(const std::vector<Support>& supports, const std::vector<MeshPatch>& patches,
+                              const std::vector<Vec3>& directions, const ElasticitySolution& solution,
+                              std::vector<bool>& released) {
+  // Reactions below this share of the loads are the solver's round-off, neither push nor pull.
+  const double noise = 1e-9 * std::sqrt(dot(solution.applied_force, solution.applied_force));
+  bool changed = false;
+  for (std::size_t i = 0; i < supports.size(); ++i) {
+    if (!supports[i].contact) continue;
+    if (!released[i]) {
+      if (dot(solution.reactions[i].force, directions[i]) > noise) released[i] = changed = true;
+      continue;
+    }
+    std::set<int> nodes;
+    for (const BoundaryQuad& q : patches[i].faces) nodes.insert(q.begin(), q.end());
+    double along = 0;
+    for (int v : nodes) along += dot(solution.vertex_displacement[v], directions[i]);
+    if (!nodes.empty() && along / static_cast<double>(nodes.size()) > 0) {
+      released[i] = false;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+}  // namespace hexbite
