@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -96,6 +97,20 @@ void check_mesh(const HexMesh& mesh, const std::string& where) {
                            "fix the connectivity where the mesh was made");
     }
   }
+  // A hex listed twice doubles the volume and the stiffness there and turns the faces between the copies
+  // into interior faces (quality said "2 hexes", refine doubled them, reorder failed with internal text).
+  std::vector<std::pair<std::array<int, 8>, std::size_t>> sorted(mesh.hexes.size());
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    sorted[h] = {mesh.hexes[h], h};
+    std::sort(sorted[h].first.begin(), sorted[h].first.end());
+  }
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t i = 1; i < sorted.size(); ++i)
+    if (sorted[i].first == sorted[i - 1].first)
+      throw InputError(where + ": hexahedra " + std::to_string(sorted[i - 1].second) + " and " +
+                       std::to_string(sorted[i].second) +
+                       " (0-based) have the same 8 vertices: a hexahedron listed twice; remove the copies "
+                       "where the mesh was made");
 }
 
 void check_arrays(const std::vector<MeshArray>& arrays, std::size_t count, const char* kind,
@@ -406,6 +421,7 @@ class MshReader {
     if constexpr (std::is_floating_point_v<V>)
       if (!std::isfinite(value)) fail("'" + token + "' is not a finite number");
   }
+  long line() const { return line_no_; }
   void expect_end(const std::string& section) {
     std::string line;
     if (!next_line(line) || line != "$End" + section) fail("expected $End" + section);
@@ -474,6 +490,7 @@ HexMesh read_msh(const std::string& path) {
       r.fail("node tag " + std::to_string(tag) + " appears twice");
     mesh.vertices.push_back(p);
   };
+  std::map<std::array<long, 8>, std::pair<long, long>> hex_lines;  // sorted nodes -> (tag, line)
   auto add_element = [&](long tag, int type, const std::vector<long>& nodes) {
     const int dim = gmsh_element_dimension(type);
     if (dim < 0)
@@ -498,6 +515,16 @@ HexMesh read_msh(const std::string& path) {
                  " of 8); a hexahedron needs 8 distinct nodes: collapsed hexes are not supported, fix the "
                  "connectivity where the mesh was made");
     }
+    // A volume in two physical groups has its elements written once per group in MSH 2.2.
+    std::array<long, 8> key;
+    std::copy(nodes.begin(), nodes.end(), key.begin());
+    std::sort(key.begin(), key.end());
+    const auto [first, fresh] = hex_lines.emplace(key, std::make_pair(tag, r.line()));
+    if (!fresh)
+      r.fail("hexahedron " + std::to_string(tag) + " has the same 8 nodes as hexahedron " +
+             std::to_string(first->second.first) + " (line " + std::to_string(first->second.second) +
+             "): a hexahedron listed twice (Gmsh writes a volume's elements once per physical group that "
+             "holds it): keep the volume in one physical group, or remove the copies");
     mesh.hexes.push_back(hex);
   };
 

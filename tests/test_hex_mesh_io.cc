@@ -207,6 +207,21 @@ TEST(HexMeshIo, ReadersRejectMeshesWithoutHexesOrWithCollapsedHexes) {
   // By the file's element and node tags and its line (was "hexahedron 0 lists vertex 5": 0-based numbers).
   EXPECT_NE(msg.find("line 17: hexahedron 1 lists node 6 twice (corners 6 and 7 of 8)"), std::string::npos)
       << msg;
+  // A hex listed twice (Gmsh writes a volume's elements once per physical group) was read as two hexes:
+  // twice the volume, every node interior, refine doubled it and reorder failed with internal text.
+  std::string twice = header;
+  twice.replace(twice.rfind("$Elements\n1\n"), 12, "$Elements\n2\n");
+  write_file(dir + "/twice.msh",
+             twice + "1 5 2 1 1 1 2 3 4 5 6 7 8\n2 5 2 2 1 5 6 7 8 1 2 3 4\n$EndElements\n");
+  msg = test::message_of<InputError>([&] { read_msh(dir + "/twice.msh"); });
+  EXPECT_NE(msg.find("line 18: hexahedron 2 has the same 8 nodes as hexahedron 1 (line 17): a hexahedron "
+                     "listed twice"),
+            std::string::npos)
+      << msg;
+  write_file(dir + "/twice.vtu",
+             ascii_vtu(2, "12 12", "0 1 2 3 4 5 6 7 4 5 6 7 0 1 2 3", "8 16", kCubePoints, 8));
+  msg = test::message_of<InputError>([&] { read_vtu(dir + "/twice.vtu"); });
+  EXPECT_NE(msg.find("hexahedra 0 and 1 (0-based) have the same 8 vertices"), std::string::npos) << msg;
   // A node count the blocks do not reach was read without a word.
   write_file(dir + "/count.msh",
              "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 99 1 99\n3 1 0 1\n1\n0 0 0\n$EndNodes\n");
