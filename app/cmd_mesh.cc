@@ -27,6 +27,7 @@
 #include "app/mesh_sheets_surface.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/auto_core.h"
 #include "mesher/boundary_fit.h"
@@ -290,7 +291,7 @@ void run_mesh(const MeshOptions& o) {
   }
 
   if (o.json)
-    std::cout << report_json(o, mesh, report, choice, write).dump(2) << '\n';
+    std::cout << json_text(report_json(o, mesh, report, choice, write)) << '\n';
   else if (!is_quiet())
     std::cout << report_text(o, mesh, report, choice);
   if (!valid) {

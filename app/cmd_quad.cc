@@ -19,6 +19,7 @@
 #include "app/mesh_sheets_surface.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
@@ -128,7 +129,7 @@ void run_quad_check(const QuadCheckOptions& o) {
   const QuadSurface surface = read_quad_surface(o.file);
   const QuadSurfaceReport report = check_quad_surface(surface, o.file);
   if (o.json)
-    std::cout << report_json(report).dump(2) << std::endl;
+    std::cout << json_text(report_json(report)) << std::endl;
   else
     info(report_text(report));
   if (!report.usable()) {
@@ -156,12 +157,11 @@ void run_quad_from_mesh(const QuadFromMeshOptions& o) {
   const HexBoundary boundary = extract_boundary(mesh);
   write_quad_obj(o.output, boundary.surface);
   if (o.json) {
-    std::cout << nlohmann::json{{"mesh", o.mesh},
-                                {"hexes", mesh.hexes.size()},
-                                {"quads", boundary.surface.quads.size()},
-                                {"vertices", boundary.surface.vertices.size()},
-                                {"output", o.output}}
-                     .dump(2)
+    std::cout << json_text(nlohmann::json{{"mesh", o.mesh},
+                                          {"hexes", mesh.hexes.size()},
+                                          {"quads", boundary.surface.quads.size()},
+                                          {"vertices", boundary.surface.vertices.size()},
+                                          {"output", o.output}})
               << std::endl;
     return;
   }

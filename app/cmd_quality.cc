@@ -12,6 +12,7 @@
 
 #include "app/commands.h"
 #include "app/option_checks.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
@@ -143,7 +144,7 @@ void add_quality_command(CLI::App& app) {
       // The volume lets benchmarks compare a mesh with its surface (and peers' meshes with ours).
       nlohmann::json j = quality_to_json(summary, hex_mesh_volume(mesh));
       if (list_worst) j["worst"] = worst_json(worst);
-      std::cout << j.dump(2) << '\n';
+      std::cout << json_text(j) << '\n';
     } else if (!is_quiet()) {  // --quiet: like every other report, only the exit code tells
       std::cout << quality_table(options->mesh, summary);
       if (!worst.empty()) std::cout << worst_table(worst);

@@ -18,6 +18,7 @@
 #include "app/mesh_inputs.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/boundary_fit.h"
 #include "mesher/hex_boundary.h"
@@ -214,7 +215,7 @@ void run_refine(const RefineCliOptions& o) {
   if (valid) write_hex_mesh(o.output, fine);
 
   if (o.json)
-    std::cout << report_json(o, report, valid).dump(2) << '\n';
+    std::cout << json_text(report_json(o, report, valid)) << '\n';
   else if (!is_quiet())
     std::cout << report_text(o, report);
   if (!valid) {

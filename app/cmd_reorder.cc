@@ -17,6 +17,7 @@
 #include "app/commands.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_reorder.h"
@@ -127,7 +128,7 @@ void run_reorder(const ReorderOptions& o) {
     j["before"] = {{"bandwidth", r.before.bandwidth}, {"profile", r.before.profile}};
     j["after"] = {{"bandwidth", r.after.bandwidth}, {"profile", r.after.profile}};
     j["seconds"] = seconds;
-    std::cout << j.dump(2) << '\n';
+    std::cout << json_text(j) << '\n';
     return;
   }
   if (is_quiet()) return;

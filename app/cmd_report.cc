@@ -12,6 +12,7 @@
 #include "app/option_checks.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "postprocess/render.h"
 #include "postprocess/report_pictures.h"
@@ -89,7 +90,7 @@ void write_report(const ReportArgs& a) {
   if (a.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const ReportPicture& p : pictures) list.push_back({{"field", p.field}, {"view", p.view}});
-    std::cout << nlohmann::json{{"report", a.output}, {"pictures", list}, {"warnings", warnings}}.dump(2)
+    std::cout << json_text(nlohmann::json{{"report", a.output}, {"pictures", list}, {"warnings", warnings}})
               << '\n';
   }
   info("wrote " + a.output + " (" + std::to_string(pictures.size()) + " pictures, " +

@@ -23,6 +23,7 @@
 #include "app/run_outputs.h"
 #include "app/run_pipeline.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "solver/mpi_session.h"
 
@@ -55,10 +56,10 @@ void run_run(const RunCliOptions& o) {
   const double seconds_output =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const nlohmann::json results = results_json(result, seconds_output);
-  outputs.commit(results.dump(2) + '\n');
+  outputs.commit(json_text(results) + '\n');
 
   if (root && o.json) {
-    std::cout << results.dump(2) << '\n';
+    std::cout << json_text(results) << '\n';
   } else if (root && !is_quiet()) {
     std::cout << "Scenario " << result.scenario.name << " (" << o.scenario << "), "
               << result.levels.size() - 1 << " validation level" << (result.levels.size() == 2 ? "" : "s")

@@ -25,6 +25,7 @@
 #include "app/run_pipeline.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/output_stage.h"
 #include "common/progress.h"
 #include "postprocess/study_table.h"
@@ -125,7 +126,7 @@ void run_study(const StudyCliOptions& o) {
         // scenario_file names the base; this says which study and which changes made these results, so
         // that the folder (and a report of it) is not taken for the base scenario's.
         results["study"] = {{"name", study.name}, {"file", study.path}, {"variant", v.name}, {"set", v.set}};
-        outputs.commit(results.dump(2) + '\n');
+        outputs.commit(json_text(results) + '\n');
         for (const std::string& f : written) files.push_back(v.name + "/" + f);
         files.push_back(v.name + "/results.json");
         require_trustworthy(r, "the results of variant '" + v.name + "'");
@@ -136,7 +137,7 @@ void run_study(const StudyCliOptions& o) {
     const nlohmann::ordered_json j = study_json(table);
     write_file_atomically(stage.stage_dir() + "/study.csv", study_csv(j));
     write_file_atomically(stage.stage_dir() + "/study.md", study_markdown(j));
-    write_file_atomically(stage.stage_dir() + "/study.json", j.dump(2) + '\n');
+    write_file_atomically(stage.stage_dir() + "/study.json", json_text(j) + '\n');
     for (const char* name : {"study.csv", "study.md", "study.json"}) files.push_back(name);  // json last
     // An earlier study's output files in a variant's folder that this one does not rewrite go; the tables
     // are always rewritten, and everything else (other folders, your own files) stays.
@@ -146,7 +147,7 @@ void run_study(const StudyCliOptions& o) {
     });
 
     if (o.json) {
-      std::cout << j.dump(2) << '\n';
+      std::cout << json_text(j) << '\n';
     } else if (!is_quiet()) {
       char total[64];
       std::snprintf(total, sizeof total, "%.1f", seconds_since(start));

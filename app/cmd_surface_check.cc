@@ -15,6 +15,7 @@
 #include "app/commands.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/surface_check.h"
 #include "mesher/surface_io.h"
@@ -142,7 +143,7 @@ void run_check(const CheckOptions& o) {
   if (o.json) {
     nlohmann::json j = report_json(report);
     j["output"] = write ? nlohmann::json(o.output) : nlohmann::json();
-    std::cout << j.dump(2) << std::endl;
+    std::cout << json_text(j) << std::endl;
   } else {
     info(report_text(report) + (write ? "\nwrote the repaired surface to " + o.output : ""));
   }

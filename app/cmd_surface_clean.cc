@@ -17,6 +17,7 @@
 #include "app/mesh_inputs.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/surface_clean.h"
 #include "mesher/surface_io.h"
@@ -103,7 +104,7 @@ void run_clean(const CleanCommandOptions& o) {
   const TriSurface cleaned = clean_surface(surface, o.clean, &report);
   write_surface(o.output, cleaned);
   if (o.json)
-    std::cout << report_json(report).dump(2) << std::endl;
+    std::cout << json_text(report_json(report)) << std::endl;
   else
     info(report_text(report, o.clean.min_angle_deg, o.output));
 }

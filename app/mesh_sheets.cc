@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/cycle_elimination.h"
 #include "mesher/hex_mesh_io.h"
@@ -73,7 +74,7 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
     j["inverted_without_pillow"] = report.inverted_without_pillow;
     j["seconds"] = {{"elimination", report.seconds_elimination}, {"embedding", report.seconds_embedding}};
     j["output"] = write ? nlohmann::json(o.output) : nlohmann::json();
-    std::cout << j.dump(2) << '\n';
+    std::cout << json_text(j) << '\n';
   } else if (!is_quiet()) {
     std::cout << report_text(o, report);
   }

@@ -13,6 +13,7 @@
 #include "app/mesh_sheets.h"
 #include "app/option_checks.h"
 #include "common/error.h"
+#include "common/json_text.h"
 #include "common/progress.h"
 #include "mesher/cycle_elimination.h"
 #include "mesher/grid_mesher.h"
@@ -213,7 +214,7 @@ void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
     j["target_quads"] = o.target_quads;
     j["local_refinement"] = refinement_json(o.refine, refinement_report);
     j["output"] = o.output;
-    std::cout << j.dump(2) << '\n';
+    std::cout << json_text(j) << '\n';
   } else if (!is_quiet()) {
     std::cout << quad_text(o.surface, report, check) << refinement_text(o.refine, refinement_report);
     info("wrote " + o.output);
@@ -270,7 +271,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     j["volume_fit"] =
         sheet_report.volume_fit ? volume_fit_to_json(*sheet_report.volume_fit) : nlohmann::json();
     j["output"] = write ? nlohmann::json(qo.output) : nlohmann::json();
-    std::cout << j.dump(2) << '\n';
+    std::cout << json_text(j) << '\n';
   } else if (!is_quiet()) {
     std::ostringstream out;
     out << quad_text(qo.surface, quad_report, check) << refinement_text(qo.refine, sheet_report.refinement);

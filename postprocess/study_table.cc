@@ -85,7 +85,8 @@ std::string markdown_figure(const json& value, const json& change, int decimals)
 std::string study_changes(const json& set, bool abbreviate) {
   std::string out;
   for (const auto& [path, value] : set.items()) {
-    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    std::string text = value.is_string() ? value.get<std::string>()
+                                         : value.dump(-1, ' ', false, json::error_handler_t::replace);
     if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
     out += (out.empty() ? "" : "; ") + path + ": " + text;
   }

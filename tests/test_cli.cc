@@ -574,6 +574,21 @@ TEST(Cli, JsonOutputIsOnlyJsonWithoutQuiet) {
   EXPECT_NE(r.err.find("mesh.core auto: the swept core"), std::string::npos) << r.err;
 }
 
+// File names need not be UTF-8 (Linux allows any bytes, e.g. Latin-1 'é' = 0xe9), but JSON text must be:
+// --json failed with nlohmann's "invalid UTF-8 byte" exception (exit 1) after the output was written. The
+// bytes are now written as U+FFFD.
+TEST(Cli, JsonOutputOfANameThatIsNotUtf8) {
+  const std::string dir = temp_dir(), latin1 = dir + "/cube\xe9.obj";
+  test::write_file(latin1, cube_obj());
+  auto r = run_hexbite({"surface", "check", latin1, "--json"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(nlohmann::json::accept(r.out)) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["file"], dir + "/cube\xef\xbf\xbd.obj");
+  r = run_hexbite({"surface", "clean", latin1, "-o", dir + "/clean\xe9.stl", "--json"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::accept(r.out)) << r.out;
+}
+
 // An option of one value given twice stopped with CLI11's "--levels: At Most 1 required but received 2",
 // which names neither what is wrong nor what to do. Now, for every command: which option, and to give it
 // once.
