@@ -119,7 +119,8 @@ std::string report_text(const QuadSurfaceReport& r) {
   } else {
     row("chords", "undefined (the surface is open, non-manifold or has degenerate quads)");
   }
-  s << "problems:" << (r.problems.empty() ? " none\n" : "\n");
+  s << "problems"
+    << (r.problems.empty() ? ": none\n" : " (indices 0-based: the file's n-th vertex or face is n - 1):\n");
   for (const auto& line : r.problems) s << "  - " << line << '\n';
   s << (r.usable() ? "usable for --method sheets: yes" : "usable for --method sheets: no");
   return s.str();
@@ -127,7 +128,13 @@ std::string report_text(const QuadSurfaceReport& r) {
 
 void run_quad_check(const QuadCheckOptions& o) {
   const QuadSurface surface = read_quad_surface(o.file);
-  const QuadSurfaceReport report = check_quad_surface(surface, o.file);
+  QuadSurfaceReport report = check_quad_surface(surface, o.file);
+  // "usable for --method sheets" means with the embedding, which keeps the boundary as it is: a quad
+  // corner on one line with its neighbours makes every mesh invalid (it was "usable: yes", and the mesh
+  // command then refused the surface).
+  if (report.closed && report.manifold)
+    if (const std::string flat = collinear_corners_problem(surface); !flat.empty())
+      report.problems.push_back(flat);
   if (o.json)
     std::cout << json_text(report_json(report)) << std::endl;
   else
@@ -136,7 +143,8 @@ void run_quad_check(const QuadCheckOptions& o) {
     for (const auto& p : report.problems) std::cerr << "hexbite: error: '" << o.file << "': " << p << '\n';
     throw InputError("'" + o.file + "' cannot bound a hex mesh by cycle elimination (" +
                      std::to_string(report.problems.size()) +
-                     (report.problems.size() == 1 ? " problem" : " problems") + " above)");
+                     (report.problems.size() == 1 ? " problem" : " problems") +
+                     " above; their indices are 0-based: the file's n-th vertex or face is n - 1)");
   }
 }
 

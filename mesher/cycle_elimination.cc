@@ -743,33 +743,6 @@ HexMesh sheet_complex(const QuadSurface& surface, const SheetMeshOptions& option
   return mesh;
 }
 
-// The embedding keeps the boundary where it is. At a corner b of a quad (a, b, c, d) whose neighbours a and
-// c lie on one line with it, every hex on the quad has the corner Jacobian det(a - b, c - b, x - b) = 0,
-// whatever its fourth edge b -> x: no hex mesh with this boundary is valid. InputError naming the first such
-// corner and how many there are.
-void throw_on_collinear_corners(const QuadSurface& surface) {
-  int flat = 0;
-  std::string first;
-  for (std::size_t q = 0; q < surface.quads.size(); ++q)
-    for (int k = 0; k < 4; ++k) {
-      const Quad& quad = surface.quads[q];
-      const int a = quad[(k + 3) % 4], b = quad[k], c = quad[(k + 1) % 4];
-      const Vec3 u = vec3::sub(surface.vertices[a], surface.vertices[b]);
-      const Vec3 w = vec3::sub(surface.vertices[c], surface.vertices[b]);
-      if (vec3::norm(vec3::cross(u, w)) > 1e-12 * vec3::norm(u) * vec3::norm(w)) continue;
-      if (flat++ > 0) continue;
-      const std::string id_b = std::to_string(b);
-      first = "quad " + std::to_string(q) + " (vertices " + std::to_string(quad[0]) + ", " +
-              std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) +
-              ") has three collinear corners " + std::to_string(a) + ", " + id_b + ", " + std::to_string(c) +
-              ": every hex on it has a corner Jacobian of 0 at vertex " + id_b +
-              " whatever the interior, so no valid hex mesh has this boundary (fixed at the input); " +
-              "move vertex " + id_b + " off the line (make the quad convex)";
-    }
-  if (flat > 0)
-    throw InputError(first + (flat > 1 ? " (" + std::to_string(flat) + " such quad corners in all)" : ""));
-}
-
 // The surface with every quad's corners reversed when the quads face inward (the volume they enclose, each
 // split along its 0-2 diagonal, is negative): the same solid, whose hexes would otherwise all be inverted.
 QuadSurface facing_outward(const QuadSurface& surface) {
@@ -796,7 +769,10 @@ HexMesh mesh_by_cycle_elimination(const QuadSurface& input, const SheetMeshOptio
   const QuadSurface surface = facing_outward(input);
   SheetMeshReport counts;
   HexMesh mesh = sheet_complex(surface, options, 0, options.decomposition.max_depth, counts);
-  if (options.optimize) throw_on_collinear_corners(surface);
+  // The embedding keeps the boundary where it is: a quad corner on one line with its neighbours leaves
+  // every hex there with a zero corner Jacobian.
+  if (options.optimize)
+    if (const std::string flat = collinear_corners_problem(surface); !flat.empty()) throw InputError(flat);
   const auto t1 = Clock::now();
   const int n = static_cast<int>(surface.vertices.size());
   OptimizeReport opt = embed(mesh, n, options);

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/boyer_myrvold_planar_test.hpp>
+#include <cstdio>
 #include <numeric>
 #include <stdexcept>
+
+#include "mesher/vec3.h"
 
 namespace hexbite {
 
@@ -102,7 +105,47 @@ bool biconnected_without(const Csr& g, int removed, std::vector<int>& disc, std:
   return true;
 }
 
+// "vertex 4 at (0.5, 0, 0.5)": a vertex by its 0-based index and its place.
+std::string vertex_at(const QuadSurface& surface, int v) {
+  const Vec3& p = surface.vertices[static_cast<std::size_t>(v)];
+  char text[128];
+  std::snprintf(text, sizeof text, "vertex %d at (%g, %g, %g)", v, p[0], p[1], p[2]);
+  return text;
+}
+
+// "edge 3-7 of quad 5, from (...) to (...)".
+std::string edge_at(const QuadSurface& surface, const std::array<int, 2>& e, int quad) {
+  const Vec3 &a = surface.vertices[static_cast<std::size_t>(e[0])],
+             &b = surface.vertices[static_cast<std::size_t>(e[1])];
+  char text[192];
+  std::snprintf(text, sizeof text, "edge %d-%d of quad %d, from (%g, %g, %g) to (%g, %g, %g)", e[0], e[1],
+                quad, a[0], a[1], a[2], b[0], b[1], b[2]);
+  return text;
+}
+
 }  // namespace
+
+std::string collinear_corners_problem(const QuadSurface& surface) {
+  int flat = 0;
+  std::string first;
+  for (std::size_t q = 0; q < surface.quads.size(); ++q)
+    for (int k = 0; k < 4; ++k) {
+      const std::array<int, 4>& quad = surface.quads[q];
+      const int a = quad[(k + 3) % 4], b = quad[k], c = quad[(k + 1) % 4];
+      const Vec3 u = vec3::sub(surface.vertices[a], surface.vertices[b]);
+      const Vec3 w = vec3::sub(surface.vertices[c], surface.vertices[b]);
+      if (vec3::norm(vec3::cross(u, w)) > 1e-12 * vec3::norm(u) * vec3::norm(w)) continue;
+      if (flat++ > 0) continue;
+      first = "quad " + std::to_string(q) + " (vertices " + std::to_string(quad[0]) + ", " +
+              std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) +
+              ") has three collinear corners " + std::to_string(a) + ", " + std::to_string(b) + ", " +
+              std::to_string(c) + ": every hex on it has a corner Jacobian of 0 at " + vertex_at(surface, b) +
+              " whatever the interior, so no valid hex mesh has this boundary; move that vertex off the line "
+              "(make the quad convex)";
+    }
+  if (flat == 0) return "";
+  return first + (flat > 1 ? " (" + std::to_string(flat) + " such quad corners in all)" : "");
+}
 
 QuadEdges build_quad_edges(const std::vector<std::array<int, 4>>& quads) {
   struct Side {
@@ -202,10 +245,19 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   r.vertices = static_cast<int>(std::count(used.begin(), used.end(), 1));
   r.unused_vertices = nv - r.vertices;
 
-  for (const auto& q : quads) {
-    std::array<int, 4> s = q;
+  // The first place of each problem, for its message (0-based).
+  std::string first_degenerate, first_duplicate, first_open, first_non_manifold_edge, first_inconsistent,
+      first_non_manifold_vertex, first_unused;
+  for (int v = 0; v < nv && first_unused.empty(); ++v)
+    if (!used[v]) first_unused = vertex_at(surface, v);
+  for (int q = 0; q < nq; ++q) {
+    std::array<int, 4> s = quads[q];
     std::sort(s.begin(), s.end());
-    if (std::adjacent_find(s.begin(), s.end()) != s.end()) ++r.degenerate_quads;
+    if (std::adjacent_find(s.begin(), s.end()) == s.end()) continue;
+    if (r.degenerate_quads++ == 0)
+      first_degenerate = "quad " + std::to_string(q) + " (vertices " + std::to_string(quads[q][0]) + ", " +
+                         std::to_string(quads[q][1]) + ", " + std::to_string(quads[q][2]) + ", " +
+                         std::to_string(quads[q][3]) + ")";
   }
   {
     std::vector<std::pair<std::array<int, 4>, int>> sorted;
@@ -216,7 +268,9 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
     }
     std::sort(sorted.begin(), sorted.end());
     for (std::size_t i = 1; i < sorted.size(); ++i)
-      if (sorted[i].first == sorted[i - 1].first) ++r.duplicate_quads;
+      if (sorted[i].first == sorted[i - 1].first && r.duplicate_quads++ == 0)
+        first_duplicate = "quads " + std::to_string(std::min(sorted[i - 1].second, sorted[i].second)) +
+                          " and " + std::to_string(std::max(sorted[i - 1].second, sorted[i].second));
   }
 
   const QuadEdges qe = build_quad_edges(quads);
@@ -228,8 +282,10 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   std::vector<std::array<int, 2>> sharing;  // quad pairs across manifold edges
   for (std::size_t e = 0; e < qe.edges.size(); ++e) {
     const auto& list = qe.edge_quads[e];
-    if (list.size() == 1) ++r.open_edges;
-    if (list.size() > 2) ++r.non_manifold_edges;
+    if (list.size() == 1 && r.open_edges++ == 0) first_open = edge_at(surface, qe.edges[e], list[0][0]);
+    if (list.size() > 2 && r.non_manifold_edges++ == 0)
+      first_non_manifold_edge =
+          edge_at(surface, qe.edges[e], list[0][0]) + ", in " + std::to_string(list.size()) + " quads";
     for (std::size_t i = 1; i < list.size(); ++i) components.unite(list[0][0], list[i][0]);
     if (list.size() != 2) continue;
     const auto [q1, k1] = list[0];
@@ -237,7 +293,8 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
     sharing.push_back({std::min(q1, q2), std::max(q1, q2)});
     // Quads are oriented consistently when they traverse their shared edge in opposite directions.
     const bool same_direction = quads[q1][k1] == quads[q2][k2];
-    if (same_direction) ++r.inconsistent_edges;
+    if (same_direction && r.inconsistent_edges++ == 0)
+      first_inconsistent = edge_at(surface, qe.edges[e], q1) + " and quad " + std::to_string(q2);
     for (int v : qe.edges[e]) {
       int c1 = -1, c2 = -1;
       for (int k = 0; k < 4; ++k) {
@@ -260,6 +317,9 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
           bad[v] = true;
       }
     r.non_manifold_vertices = static_cast<int>(std::count(bad.begin(), bad.end(), true));
+    const auto pinched = std::find(bad.begin(), bad.end(), true);
+    if (pinched != bad.end())
+      first_non_manifold_vertex = vertex_at(surface, static_cast<int>(pinched - bad.begin()));
   }
   for (int q = 0; q < nq; ++q)
     if (components.find(q) == q) ++r.components;
@@ -304,22 +364,26 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
     for (std::size_t i = 1; i < positions.size(); ++i)
       if (positions[i] == positions[i - 1]) ++coincident;
     r.problems.push_back(
-        "not closed: " + count(r.open_edges, "open edge", "open edges") + " (edges in only one quad); " +
+        "not closed: " + count(r.open_edges, "open edge", "open edges") +
+        " (edges in only one quad; the first: " + first_open + "); " +
         (coincident > 0 ? count(coincident, "vertex lies", "vertices lie") +
                               " exactly on another one: the quads are not welded, merge coincident vertices "
                               "where the surface was made"
                         : std::string("close the holes")));
   }
   if (!r.manifold)
-    r.problems.push_back("not manifold: " + count(r.non_manifold_edges, "edge", "edges") +
-                         " in more than two quads, " +
-                         count(r.non_manifold_vertices, "non-manifold vertex", "non-manifold vertices"));
+    r.problems.push_back(
+        "not manifold: " + count(r.non_manifold_edges, "edge", "edges") + " in more than two quads" +
+        (first_non_manifold_edge.empty() ? "" : " (the first: " + first_non_manifold_edge + ")") + ", " +
+        count(r.non_manifold_vertices, "non-manifold vertex", "non-manifold vertices") +
+        (first_non_manifold_vertex.empty() ? "" : " (the first: " + first_non_manifold_vertex + ")"));
   if (r.degenerate_quads > 0)
     r.problems.push_back(count(r.degenerate_quads, "degenerate quad", "degenerate quads") +
-                         " (a repeated vertex)");
+                         " (a repeated vertex; the first: " + first_degenerate + ")");
   if (r.closed && r.manifold && !r.consistently_oriented)
     r.problems.push_back("inconsistent orientation: " + count(r.inconsistent_edges, "edge", "edges") +
-                         " traversed in the same direction by both quads");
+                         " traversed in the same direction by both quads (the first: " + first_inconsistent +
+                         "); turn the quads of one side around");
   if (r.components > 1)
     r.problems.push_back("not a ball: " + std::to_string(r.components) + " separate components");
   else if (r.genus > 0)
@@ -328,12 +392,14 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
                          "); the sheet mesher needs a topological "
                          "ball (genus 0); use the grid method");
   if (r.unused_vertices > 0)
-    r.problems.push_back(count(r.unused_vertices, "vertex", "vertices") + " in no quad; remove them");
+    r.problems.push_back(count(r.unused_vertices, "vertex", "vertices") +
+                         " in no quad (the first: " + first_unused + "); remove them");
   if (r.manifold && r.degenerate_quads == 0 && !r.simple)
     r.problems.push_back("graph not simple: " +
                          count(r.quad_pairs_sharing_edges, "pair of quads shares", "pairs of quads share") +
                          " two or more edges, " +
-                         count(r.duplicate_quads, "duplicate quad", "duplicate quads"));
+                         count(r.duplicate_quads, "duplicate quad", "duplicate quads") +
+                         (first_duplicate.empty() ? "" : " (the first: " + first_duplicate + ")"));
   if (r.ball && r.simple && !r.three_connected)
     r.problems.push_back(
         "graph not 3-connected: removing two vertices disconnects it (a vertex of degree 2 "

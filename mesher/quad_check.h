@@ -116,6 +116,15 @@ struct QuadSurfaceReport {
   bool usable() const { return problems.empty(); }
 };
 
+// Indices in the report's problems are 0-based (the OBJ's vertex k is vertex k - 1 here, its face k is quad
+// k - 1), and each problem names its first place with coordinates. The problems are combinatorial (the
+// elimination's conditions); collinear_corners_problem() is the geometric one of an embedding that keeps
+// the boundary.
 QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::string& file);
+
+// The quad corners whose two neighbours lie on one line with them: a hex on such a quad has a corner
+// Jacobian of 0 there whatever the interior, so no valid hex mesh has this boundary. Empty when there is
+// none, else a message naming the first corner (0-based, with coordinates) and how many there are.
+std::string collinear_corners_problem(const QuadSurface& surface);
 
 }  // namespace hexbite

@@ -107,6 +107,22 @@ TEST(QuadCheck, ProblemsAreNamed) {
   EXPECT_GT(o.open_edges, 0);
   EXPECT_FALSE(o.ball);
   EXPECT_NE(o.problems.at(0).find("close the holes"), std::string::npos) << o.problems.at(0);
+  // Each problem names its first place (it gave counts only).
+  EXPECT_NE(o.problems.at(0).find("(edges in only one quad; the first: edge "), std::string::npos)
+      << o.problems.at(0);
+  QuadSurface flipped = test::block_surface(2, 1, 1);
+  std::reverse(flipped.quads[3].begin(), flipped.quads[3].end());
+  const QuadSurfaceReport f = check_quad_surface(flipped, "flipped");
+  ASSERT_FALSE(f.problems.empty());
+  EXPECT_NE(f.problems.back().find("traversed in the same direction by both quads (the first: edge "),
+            std::string::npos)
+      << f.problems.back();
+  QuadSurface unused = test::block_surface(1, 1, 1);
+  unused.vertices.push_back({5, 6, 7});
+  EXPECT_NE(check_quad_surface(unused, "unused")
+                .problems.at(0)
+                .find("1 vertex in no quad (the first: vertex 8 at (5, 6, 7))"),
+            std::string::npos);
 
   // Every quad with its own four corners: every edge is open although the solid is closed. "Close the
   // holes" sent the user looking for holes that are not there.
@@ -349,6 +365,15 @@ TEST(QuadSurfaceIo, LinesAndVerticesAreRefusedInEveryFormat) {
   EXPECT_NE(obj.find("remove them"), std::string::npos) << obj;
 }
 
+// A 2 x 1 x 1 box with the bottom front middle vertex (1, 0, 0) moved to (0.5, 0, 0.5), onto the line
+// between its neighbours (0, 0, 0) and (1, 0, 1) in the front left quad: that corner is straight.
+QuadSurface flat_corner_surface() {
+  QuadSurface s = test::block_surface(2, 1, 1);
+  for (Vec3& v : s.vertices)
+    if (v == Vec3{1, 0, 0}) v = {0.5, 0, 0.5};
+  return s;
+}
+
 TEST(QuadCheckCli, ExitCodesAndMessages) {
   const std::string dir = test::temp_dir();
   write_quad_obj(dir + "/block.obj", test::block_surface(2, 3, 4));
@@ -371,7 +396,10 @@ TEST(QuadCheckCli, ExitCodesAndMessages) {
       {"odd", odd_surface(), "odd number of quads (7)"},
       {"open", open, "not closed: "},
       {"torus", test::torus_surface(6, 4), "not a ball: genus 1"},
-      {"twisted", test::self_intersecting_surface(), "(length 20) self-intersects"}};
+      {"twisted", test::self_intersecting_surface(), "(length 20) self-intersects"},
+      // Combinatorially fine, but no valid mesh keeps this boundary: was "usable: yes", and the mesh command
+      // then refused it.
+      {"flat_corner", flat_corner_surface(), "has three collinear corners"}};
   for (const Case& c : cases) {
     write_quad_obj(dir + "/" + c.name + ".obj", c.surface);
     const auto r = test::run_hexbite({"quad", "check", dir + "/" + c.name + ".obj"});
