@@ -7,9 +7,11 @@
 
 #include "common/error.h"
 #include "common/json_text.h"
+#include "common/number_format.h"
 #include "common/progress.h"
 #include "mesher/cycle_elimination.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
 #include "mesher/quad_surface_io.h"
 #include "postprocess/quality_json.h"
 
@@ -81,7 +83,10 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
   if (!valid && !o.allow_invalid)
     throw RunError(
         std::to_string(report.quality.inverted) +
-        " hexes stay inverted after optimization; no mesh written (--allow-invalid writes it anyway)");
+        " hexes stay inverted after optimization: " + hex_list_text(mesh, report.quality.inverted_hexes) +
+        "; the quad surface may fold over itself there (quads that cross each other bound no solid): "
+        "check it, or mesh the solid with --method grid; no mesh written (--allow-invalid writes it "
+        "anyway)");
   if (!o.json) info("wrote " + o.output);
 }
 
@@ -115,13 +120,13 @@ std::string sheet_quality_text(const QualitySummary& q) {
       << q.node_degree.max_edges << "\n";
   out << "interior node degrees (hexes): " << histogram_text(q.node_degree.hexes) << "; maximum "
       << q.node_degree.max_hexes << "\n";
-  char line[256];
-  std::snprintf(line, sizeof line,
-                "quality: scaled Jacobian min %.4f mean %.4f max %.4f; condition (cube = 3) min %.3f mean "
-                "%.3f max %.3f; Oddy mean %.3f max %.3f; %d inverted\n",
-                q.scaled_jacobian.min, q.scaled_jacobian.mean, q.scaled_jacobian.max, q.condition.min,
-                q.condition.mean, q.condition.max, q.oddy.mean, q.oddy.max, q.inverted);
-  out << line;
+  // A measure that could not be taken (the condition number of an inverted hex) reads n/a, not nan.
+  const auto f = [](double v, int decimals) { return format_table_number(v, decimals, 0); };
+  out << "quality: scaled Jacobian min " << f(q.scaled_jacobian.min, 4) << " mean "
+      << f(q.scaled_jacobian.mean, 4) << " max " << f(q.scaled_jacobian.max, 4)
+      << "; condition (cube = 3) min " << f(q.condition.min, 3) << " mean " << f(q.condition.mean, 3)
+      << " max " << f(q.condition.max, 3) << "; Oddy mean " << f(q.oddy.mean, 3) << " max "
+      << f(q.oddy.max, 3) << "; " << q.inverted << " inverted\n";
   return out.str();
 }
 

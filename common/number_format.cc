@@ -1,5 +1,6 @@
 #include "common/number_format.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -7,6 +8,10 @@ namespace hexbite {
 
 std::string format_table_number(double value, int decimals, int width) {
   char text[512];
+  if (!std::isfinite(value)) {
+    std::snprintf(text, sizeof text, "%*s", width, "n/a");
+    return text;
+  }
   std::snprintf(text, sizeof text, "%*.*f", width, decimals, value);
   bool shows_a_digit = false;
   for (const char* c = text; *c; ++c) shows_a_digit = shows_a_digit || (*c >= '1' && *c <= '9');

@@ -9,7 +9,8 @@ namespace hexbite {
 // `value` right-aligned in `width` characters, in fixed point with `decimals` decimals ("%14.5f"), except
 // when fixed point would show a value that is not zero as zero ("0.00000" or "-0.00000" for 3e-7): that is
 // printed in scientific notation with 3 significant digits ("3.00e-07"), so that a small figure is never
-// mistaken for nothing. Not for files that programs read (results.json keeps full precision).
+// mistaken for nothing. A value that is not finite (a measure that could not be taken) is "n/a". Not for
+// files that programs read (results.json keeps full precision).
 std::string format_table_number(double value, int decimals, int width);
 
 // `value` as a stream prints it by default, with up to 6 significant digits: "96", "0.25", "1e+06". For

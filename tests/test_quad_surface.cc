@@ -409,6 +409,24 @@ TEST(QuadCheckCli, ExitCodesAndMessages) {
   }
 }
 
+// A 3 x 1 x 1 box whose top vertices over x = 1 and 2 are pulled below the bottom: the quads fold over
+// themselves. The sheet mesher's hexes stay inverted (exit 1); the message named no hex, and the quality
+// line printed "nan" for the condition numbers it could not take.
+TEST(MeshSheetsCli, InvertedHexesAreNamedWithTheirPlaces) {
+  QuadSurface fold = test::block_surface(3, 1, 1);
+  for (Vec3& v : fold.vertices)
+    if (v[1] == 0 && v[2] == 1 && (v[0] == 1 || v[0] == 2)) v[2] = -0.5;
+  const std::string dir = test::temp_dir();
+  write_quad_obj(dir + "/fold.obj", fold);
+  const auto r = test::run_hexbite(
+      {"mesh", "--quad-surface", dir + "/fold.obj", "--method", "sheets", "-o", dir + "/fold.vtu"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("hexes stay inverted after optimization: hex "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(") mm"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/fold.vtu"));
+}
+
 // `quad from-mesh` writes the boundary quads of a hex mesh (.vtu or .msh): for a 2 x 3 x 4 block its 52
 // outward faces on the 54 boundary nodes, a surface that `quad check` passes and the sheet mesher takes.
 TEST(QuadFromMeshCli, BoundaryOfABlock) {

@@ -1030,6 +1030,8 @@ TEST(RunSummaryTable, FiguresThatFixedPointShowsAsZeroAreInScientificNotation) {
   EXPECT_EQ(format_table_number(0.004, 2, 14), "      4.00e-03");
   EXPECT_EQ(format_table_number(342.5, 2, 14), "        342.50");
   EXPECT_EQ(format_table_number(1.5, 2, 6), "  1.50");
+  EXPECT_EQ(format_table_number(std::nan(""), 3, 6), "   n/a");  // a measure not taken, not "nan"
+  EXPECT_EQ(format_table_number(INFINITY, 3, 0), "n/a");
 }
 
 // The relative change of the last level printed "+0.00 %" for a change of 3e-6: a level that changed the
