@@ -74,7 +74,8 @@ void run_reorder(const ReorderOptions& o) {
         "--from and --landmarks choose where the breadth-first order starts; --method rcm picks "
         "its own start, so leave them out or use --method bfs");
   std::vector<MeshArray> cell_arrays, point_arrays;
-  const HexMesh mesh = read_hex_mesh(o.mesh, &cell_arrays, &point_arrays);
+  std::vector<std::string> not_read;
+  const HexMesh mesh = read_hex_mesh(o.mesh, &cell_arrays, &point_arrays, &not_read);
 
   const auto t0 = std::chrono::steady_clock::now();
   ReorderResult r;
@@ -116,6 +117,12 @@ void run_reorder(const ReorderOptions& o) {
   const double seconds = seconds_since(t0);
   write_hex_mesh(o.output, r.mesh, permute_arrays(cell_arrays, r.hex_order),
                  permute_arrays(point_arrays, r.node_order));
+  if (!not_read.empty()) {
+    std::string list;
+    for (const std::string& item : not_read) list += (list.empty() ? "" : ", ") + item;
+    std::cerr << "hexbite: warning: not carried over to " << o.output << ": " << list
+              << " (reorder carries the numeric cell and point arrays only).\n";
+  }
 
   if (o.json) {
     nlohmann::json j;

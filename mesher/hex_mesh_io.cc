@@ -4,6 +4,8 @@
 #include <vtkCellData.h>
 #include <vtkCellTypes.h>
 #include <vtkDataArray.h>
+#include <vtkDataArraySelection.h>
+#include <vtkFieldData.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
@@ -30,6 +32,7 @@
 #include <system_error>
 #include <type_traits>
 #include <unordered_map>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -212,7 +215,7 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
 }
 
 HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
-                 std::vector<MeshArray>* point_arrays) {
+                 std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
   check_readable(path, "hex mesh");
   const std::string where = "hex mesh '" + path + "'";
   vtkNew<vtkXMLUnstructuredGridReader> reader;
@@ -270,6 +273,20 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   check_mesh(mesh, where);
   if (cell_arrays != nullptr) *cell_arrays = arrays_of(grid->GetCellData());
   if (point_arrays != nullptr) *point_arrays = arrays_of(grid->GetPointData());
+  if (not_read != nullptr) {
+    // Text arrays are left unread (update_xml_reader() disables them), and field data has no place here.
+    not_read->clear();
+    for (const auto& [kind, selection] : {std::pair{"cell", reader->GetCellDataArraySelection()},
+                                          std::pair{"point", reader->GetPointDataArraySelection()}})
+      for (int i = 0; i < selection->GetNumberOfArrays(); ++i)
+        if (selection->ArrayIsEnabled(selection->GetArrayName(i)) == 0)
+          not_read->push_back(std::string(kind) + " array '" + selection->GetArrayName(i) + "' (text)");
+    vtkFieldData* field = grid->GetFieldData();
+    for (int i = 0; field != nullptr && i < field->GetNumberOfArrays(); ++i)
+      not_read->push_back(
+          std::string("field data '") +
+          (field->GetAbstractArray(i)->GetName() ? field->GetAbstractArray(i)->GetName() : "") + "'");
+  }
   return mesh;
 }
 
@@ -649,10 +666,11 @@ void write_hex_mesh(const std::string& path, const HexMesh& mesh, const std::vec
 }
 
 HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays,
-                      std::vector<MeshArray>* point_arrays) {
-  if (lower_extension(path) != ".msh") return read_vtu(path, cell_arrays, point_arrays);
+                      std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
+  if (lower_extension(path) != ".msh") return read_vtu(path, cell_arrays, point_arrays, not_read);
   if (cell_arrays) cell_arrays->clear();
   if (point_arrays) point_arrays->clear();
+  if (not_read) not_read->clear();
   return read_msh(path);
 }
 

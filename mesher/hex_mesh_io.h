@@ -45,9 +45,11 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
                const std::vector<MeshArray>& point_arrays = {});
 
 // Reads a .vtu file of hexahedra. When given, cell_arrays and point_arrays receive the file's numeric
-// arrays (as doubles, in file order; the quality arrays included).
+// arrays (as doubles with their VTK type, in file order; the quality arrays included), and `not_read` what
+// the file holds beside them: "cell array 'label' (text)", "field data 'TimeValue'".
 HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
-                 std::vector<MeshArray>* point_arrays = nullptr);
+                 std::vector<MeshArray>* point_arrays = nullptr,
+                 std::vector<std::string>* not_read = nullptr);
 
 // Exports an Abaqus / CalculiX input deck: *NODE (NSET=NALL), *ELEMENT TYPE=C3D8 (ELSET=EALL; the C3D8 node
 // order is VTK's hexahedron order), then one *NSET / *ELSET per given set. Numbers are 1-based in the file.
@@ -78,6 +80,7 @@ void write_hex_mesh(const std::string& path, const HexMesh& mesh,
 // Reads a .msh file (read_msh) by its extension (any case), any other name as a .vtu (read_vtu, which names
 // a file that is not one); the arrays come only from a .vtu (a .msh leaves them empty).
 HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
-                      std::vector<MeshArray>* point_arrays = nullptr);
+                      std::vector<MeshArray>* point_arrays = nullptr,
+                      std::vector<std::string>* not_read = nullptr);
 
 }  // namespace hexbite

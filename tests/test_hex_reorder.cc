@@ -228,6 +228,36 @@ TEST(HexReorderCommand, ArraysKeepTheirValuesAndTypes) {
   EXPECT_NE(text.find("type=\"Int64\" Name=\"node_id\""), std::string::npos);
 }
 
+// What reorder cannot carry (text arrays, field data) is named in a warning: it was dropped without a word.
+TEST(HexReorderCommand, WhatIsNotCarriedOverIsNamed) {
+  const std::string dir = temp_dir();
+  test::write_file(
+      dir + "/in.vtu",
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n<UnstructuredGrid>"
+      "<FieldData><DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" "
+      "format=\"ascii\">2.5</DataArray></FieldData>\n"
+      "<Piece NumberOfPoints=\"8\" NumberOfCells=\"1\">\n"
+      "<CellData><DataArray type=\"String\" Name=\"label\" format=\"ascii\">98 111 110 101 0"
+      "</DataArray><DataArray type=\"Int32\" Name=\"material\" format=\"ascii\">3</DataArray>"
+      "</CellData>\n<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+      "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1</DataArray></Points>\n<Cells>"
+      "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3 4 5 6 7</DataArray>"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">8</DataArray>"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">12</DataArray>"
+      "</Cells></Piece></UnstructuredGrid></VTKFile>\n");
+  const auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/out.vtu", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: not carried over to " + dir +
+                       "/out.vtu: cell array 'label' (text), field data 'TimeValue'"),
+            std::string::npos)
+      << r.err;
+  std::vector<MeshArray> cells;
+  read_vtu(dir + "/out.vtu", &cells);
+  ASSERT_EQ(cells.size(), 5u);  // the four quality arrays and the material
+  EXPECT_EQ(cells.back().name, "material");
+  EXPECT_EQ(cells.back().vtk_type, VTK_INT);
+}
+
 TEST(HexReorderCommand, BadInput) {
   const std::string dir = temp_dir();
   write_vtu(dir + "/in.vtu", make_block_mesh(2, 2, 2));
