@@ -179,11 +179,13 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
         if (!value.IsSequence()) fail(path, value.Mark(), "'muscles' must be a list");
         for (const auto& m : value) read_muscle(path, m, scale_to_mm, out, names);
       } else {
-        fail(path, kv.first.Mark(),
-             "unknown section '" + key + "'; " +
-                 (key == "units" ? "the file's unit is given where it is read: a scenario's landmarks.units, "
-                                   "or --units"
-                                 : suggestion(key, {"landmarks", "muscles"}, "sections")));
+        fail(
+            path, kv.first.Mark(),
+            "unknown section '" + key + "'; " +
+                (key == "units" ? "a landmark file has no unit of its own: a scenario's landmarks.units says "
+                                  "it, `hexbite mesh` reads it in the --units of its surface, and `hexbite "
+                                  "reorder` in millimetres"
+                                : suggestion(key, {"landmarks", "muscles"}, "sections")));
       }
     }
   } catch (const YAML::Exception& e) {

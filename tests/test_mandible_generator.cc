@@ -362,8 +362,9 @@ TEST(Landmarks, MalformedFilesNameTheFileLineAndColumn) {
                         ":3:1: unknown section 'muscle'; did you mean 'muscles'?");
   expect_landmark_error(
       "units: cm\nlandmarks:\n  a: [1, 2, 3]\n",
-      ":1:1: unknown section 'units'; the file's unit is given where it is read: a scenario's "
-      "landmarks.units, or --units");
+      ":1:1: unknown section 'units'; a landmark file has no unit of its own: a scenario's "
+      "landmarks.units says it, `hexbite mesh` reads it in the --units of its surface, and `hexbite "
+      "reorder` in millimetres");
   // A mistyped muscle key gets the key it is a typo of (it listed the four keys only).
   expect_landmark_error("muscles:\n  - {name: m, max_force: 1, insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
                         ":2:15: unknown muscle key 'max_force'; did you mean 'max_force_N'?");
