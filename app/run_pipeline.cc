@@ -370,6 +370,12 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& b
     // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
     // away is a typo or a point of another frame, and its values would be those of an unrelated place.
     const double outside = vec3::norm(vec3::sub(foot.point, p));
+    // On the boundary (a boundary node, a point of a boundary face) is in the mesh: it was moved 0.02-0.05
+    // mm inward and its values taken there, with `moved_mm` saying so.
+    if (outside <= 1e-9 * (1.0 + vec3::norm(p))) {
+      points.push_back(p);
+      continue;
+    }
     if (outside > kProbeMaxOutsideMm) {
       char buf[400];
       std::snprintf(

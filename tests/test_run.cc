@@ -1138,6 +1138,30 @@ TEST(RunScenario, SpringSupportIsRefusedForTheCalculixExport) {
   expect_refused(text, "spring", {"--export", "inp"});
 }
 
+// A probe on a boundary node is in the mesh: its values are the node's. It was moved 0.02-0.05 mm inward
+// as if it lay outside, and results.json said so (`moved_mm`).
+TEST(RunScenario, AProbeOnABoundaryNodeIsNotMoved) {
+  const std::string dir = test::temp_dir();
+  run_cube(cube_on_a_floor("[0, 0, -1]", ""), {}, dir);
+  std::vector<MeshArray> points;
+  const HexMesh mesh = read_vtu(dir + "/out/solution.vtu", nullptr, &points);
+  std::size_t corner = 0;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    if (mesh.vertices[v][0] + mesh.vertices[v][1] + mesh.vertices[v][2] >
+        mesh.vertices[corner][0] + mesh.vertices[corner][1] + mesh.vertices[corner][2])
+      corner = v;
+  char probe[160];
+  std::snprintf(probe, sizeof probe, "probes:\n  - {name: corner, at: [%.17g, %.17g, %.17g]}\n",
+                mesh.vertices[corner][0], mesh.vertices[corner][1], mesh.vertices[corner][2]);
+  const json r = run_cube(cube_on_a_floor("[0, 0, -1]", "") + probe);
+  ASSERT_FALSE(r.is_null());
+  const json& p = r["probes"]["corner"];
+  EXPECT_EQ(p["moved_mm"].get<double>(), 0.0);
+  const MeshArray& u = array(points, "displacement");
+  for (int d = 0; d < 3; ++d)
+    EXPECT_NEAR(p["displacement_mm"][d].get<double>(), u.values[3 * corner + d], 1e-12);
+}
+
 // A released contact that leaves a direction held by nothing stops the run (exit 1): the loads lift the
 // bone off its contacts. A contact that fixes only components along its own surface cannot push, and a
 // contact cannot be a spring (exit 2, at the support's line).
