@@ -20,17 +20,26 @@ Vec3 contact_direction(const Support& support, const MeshPatch& patch, const Hex
   // Twice a bilinear quad's vector area is the cross product of its diagonals; the boundary quads are
   // oriented outward (mesher/hex_boundary.h).
   Vec3 n{0, 0, 0};
+  double area = 0;  // summed magnitudes of the quads' vector areas (twice)
   for (const BoundaryQuad& q : patch.faces) {
     const Vec3& a = mesh.vertices[q[0]];
     const Vec3& b = mesh.vertices[q[1]];
     const Vec3& c = mesh.vertices[q[2]];
     const Vec3& d = mesh.vertices[q[3]];
     const Vec3 p{c[0] - a[0], c[1] - a[1], c[2] - a[2]}, r{d[0] - b[0], d[1] - b[1], d[2] - b[2]};
-    n[0] += p[1] * r[2] - p[2] * r[1];
-    n[1] += p[2] * r[0] - p[0] * r[2];
-    n[2] += p[0] * r[1] - p[1] * r[0];
+    const Vec3 face{p[1] * r[2] - p[2] * r[1], p[2] * r[0] - p[0] * r[2], p[0] * r[1] - p[1] * r[0]};
+    for (int k = 0; k < 3; ++k) n[k] += face[k];
+    area += std::sqrt(dot(face, face));
   }
   const double length = std::sqrt(dot(n, n));
+  // A patch over both sides of a thin part (a plate thinner than the patch) faces both ways: its facets'
+  // normals cancel, and what is left of them is no direction (it was taken as one, and a contact pushing
+  // on the plate's lower side was released as pulling).
+  if (!(length >= 0.3 * area))
+    throw InputError(support.where.str() + ": contact support '" + support.name +
+                     "' faces no one way: its patch covers opposite sides of the bone (its facets' normals "
+                     "cancel: a part thinner than the patch), so what would push and what would pull is "
+                     "undefined: make radius_mm smaller, or move it onto one face");
   Vec3 held{0, 0, 0};
   for (int d = 0; d < 3; ++d)
     if (support.fixed[d] && length > 0) held[d] = n[d] / length;

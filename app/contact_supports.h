@@ -22,7 +22,9 @@ namespace hexbite {
 
 // The direction support `support` resists as a contact on `patch`: the patch's outward unit normal with
 // the components it does not fix set to zero. Throws InputError (naming the support's line) when that
-// leaves less than a tenth of the normal: a contact fixed only along its own surface cannot push.
+// leaves less than a tenth of the normal (a contact fixed only along its own surface cannot push), and when
+// the patch faces no one way (its facets' summed vector area is under 0.3 of their summed areas: it covers
+// opposite sides of a thin part).
 Vec3 contact_direction(const Support& support, const MeshPatch& patch, const HexMesh& mesh);
 
 // After a solve in which the supports flagged in `released` were left out (their reactions zero): flags

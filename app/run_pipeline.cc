@@ -412,7 +412,12 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
   for (const Support& sup : s.supports)
     r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
                                              point_place(sup.at, sup.where), "support '" + sup.name + "'"));
-  // Here, not before the solve: a probe far outside the mesh must not cost a study its earlier variants.
+  // Here, not before the solve: a contact that cannot push, or a probe far outside the mesh, must not cost a
+  // study its earlier variants.
+  r.contact_directions.assign(s.supports.size(), Vec3{0, 0, 0});
+  for (std::size_t i = 0; i < s.supports.size(); ++i)
+    if (s.supports[i].contact)
+      r.contact_directions[i] = contact_direction(s.supports[i], r.support_patches[i], r.mesh);
   r.probe_points = probe_points_in_mesh(r.mesh, boundary, s.probes);
   r.hex_material.reserve(r.mesh.hexes.size());
   // A hex takes a region's material by its centre; a region that wins no hex changes nothing, which
@@ -556,15 +561,25 @@ std::array<bool, 3> held_components(const Support& support) {
 // Every separate body of the mesh must be held by supports in x, y and z; a body that nothing holds can
 // move freely, the stiffness matrix is singular, and the solve would end in an equilibrium failure with
 // displacements of 1e12 mm. InputError naming the body and the supports' lines.
-void require_every_body_held(const Scenario& s, const LevelResult& r, const Bodies& bodies) {
-  if (bodies.count < 2) return;
+// Per body, the components that the supports' patches on it hold; the supports flagged in `left_out` (the
+// released contacts; empty: none) do not count.
+std::vector<std::array<bool, 3>> held_per_body(const Scenario& s, const LevelResult& r, const Bodies& bodies,
+                                               const std::vector<bool>& left_out = {}) {
   std::vector<std::array<bool, 3>> held(bodies.count, {false, false, false});
-  for (std::size_t i = 0; i < s.supports.size(); ++i)
+  for (std::size_t i = 0; i < s.supports.size(); ++i) {
+    if (!left_out.empty() && left_out[i]) continue;
     for (const auto& face : r.support_patches[i].faces)
       for (int v : face) {
         std::array<bool, 3>& h = held[bodies.of_vertex[v]];
         for (int a = 0; a < 3; ++a) h[a] = h[a] || held_components(s.supports[i])[a];
       }
+  }
+  return held;
+}
+
+void require_every_body_held(const Scenario& s, const LevelResult& r, const Bodies& bodies) {
+  if (bodies.count < 2) return;
+  const std::vector<std::array<bool, 3>> held = held_per_body(s, r, bodies);
   for (int b = 0; b < bodies.count; ++b) {
     if (held[b][0] && held[b][1] && held[b][2]) continue;
     std::string how = "is touched by no support";
@@ -585,11 +600,15 @@ void require_every_body_held(const Scenario& s, const LevelResult& r, const Bodi
   }
 }
 
-// The weakest rigid motion of every body against its supports; a warning for each weak one.
-std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& r, const Bodies& bodies) {
+// The weakest rigid motion of every body against its supports; a warning for each weak one, after
+// `context` ("level 1, with contact 'x' released: "). The supports flagged in `left_out` do not count.
+std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& r, const Bodies& bodies,
+                                          const std::vector<bool>& left_out = {},
+                                          const std::string& context = "") {
   const HexMesh& mesh = r.mesh;
   std::vector<std::vector<HeldPoint>> held(bodies.count);
   for (std::size_t i = 0; i < s.supports.size(); ++i) {
+    if (!left_out.empty() && left_out[i]) continue;
     std::vector<std::size_t> first(bodies.count);  // a patch may reach over several bodies
     std::vector<double> area(bodies.count, 0.0);
     for (int b = 0; b < bodies.count; ++b) first[b] = held[b].size();
@@ -631,29 +650,42 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
                   "stresses mostly measure that motion; fix more components of a support, or add a support "
                   "away from that axis",
                   m.rho, kWeakSupportHold);
-    warn(s.supports.front().where.str() + ": " + text + hold);
+    warn(s.supports.front().where.str() + ": " + context + text + hold);
   }
   return modes;
 }
 
-// Without the released contacts, some support must still hold each of x, y and z (as the scenario's own
-// check asks of all of them): else the loads lift the bone off its contacts and nothing holds it.
-void check_held_without_released(const Scenario& s, const std::vector<bool>& released, int level) {
-  std::string loose, names;
-  for (int axis = 0; axis < 3; ++axis) {
-    bool held = false;
-    for (std::size_t i = 0; i < s.supports.size(); ++i)
-      held = held || (!released[i] && (s.supports[i].spring_N_per_mm3 || s.supports[i].fixed[axis]));
-    if (!held) loose += std::string(loose.empty() ? "" : ", ") + "xyz"[axis];
-  }
-  if (loose.empty()) return;
+// "'floor', 'shelf'": the names of the supports flagged in `flags`.
+std::string flagged_names(const Scenario& s, const std::vector<bool>& flags) {
+  std::string names;
   for (std::size_t i = 0; i < s.supports.size(); ++i)
-    if (released[i]) names += (names.empty() ? "'" : ", '") + s.supports[i].name + "'";
-  throw RunError(
-      s.supports.front().where.str() + ": level " + std::to_string(level) + ": the contact " + names +
-      " would pull the bone, and without it no support holds it along " + loose +
-      ": the loads lift the bone off its contacts; check the muscles' directions, or hold the bone "
-      "with a support that is not a contact");
+    if (flags[i]) names += (names.empty() ? "'" : ", '") + s.supports[i].name + "'";
+  return names;
+}
+
+// Without the released contacts, the supports must still hold every body in x, y and z (as the scenario's
+// own check asks of all of them): else the loads lift it off its contacts and nothing holds it (the solve
+// gave displacements of 1e12 mm and an equilibrium failure).
+void check_held_without_released(const Scenario& s, const LevelResult& r, const std::vector<bool>& released) {
+  if (std::none_of(released.begin(), released.end(), [](bool b) { return b; })) return;
+  const Bodies bodies = split_bodies(r.mesh);
+  const std::vector<std::array<bool, 3>> held = held_per_body(s, r, bodies, released);
+  for (int b = 0; b < bodies.count; ++b) {
+    std::string loose;
+    for (int axis = 0; axis < 3; ++axis)
+      if (!held[b][axis]) loose += std::string(loose.empty() ? "" : ", ") + "xyz"[axis];
+    if (loose.empty()) continue;
+    char body[160] = " it";
+    if (bodies.count > 1)
+      std::snprintf(body, sizeof body, " body %d of %d (%ld hexes, around (%.1f, %.1f, %.1f) mm)", b + 1,
+                    bodies.count, bodies.hexes[b], bodies.centre[b][0], bodies.centre[b][1],
+                    bodies.centre[b][2]);
+    throw RunError(s.supports.front().where.str() + ": level " + std::to_string(r.level) + ": the contact " +
+                   flagged_names(s, released) + " would pull the bone, and without it no support holds" +
+                   body + " along " + loose +
+                   ": the loads lift the bone off its contacts; check the muscles' directions, or hold the "
+                   "bone with a support that is not a contact");
+  }
 }
 
 void solve_level(const Scenario& s, LevelResult& r) {
@@ -696,9 +728,6 @@ void solve_level(const Scenario& s, LevelResult& r) {
   // settles (app/contact_supports.h); a set seen before would cycle.
   const std::vector<SupportPatch> all_supports = std::move(p.supports);
   std::vector<bool> released(s.supports.size(), false);
-  std::vector<Vec3> directions(s.supports.size(), Vec3{0, 0, 0});
-  for (std::size_t i = 0; i < s.supports.size(); ++i)
-    if (s.supports[i].contact) directions[i] = contact_direction(s.supports[i], r.support_patches[i], r.mesh);
   std::set<std::vector<bool>> seen;
   const auto start = std::chrono::steady_clock::now();
   for (;;) {
@@ -706,7 +735,7 @@ void solve_level(const Scenario& s, LevelResult& r) {
     p.supports.clear();
     for (std::size_t i = 0; i < s.supports.size(); ++i)
       if (!released[i]) p.supports.push_back(all_supports[i]);
-    check_held_without_released(s, released, r.level);
+    check_held_without_released(s, r, released);
     Progress progress("solve level " + std::to_string(r.level));
     try {
       r.solution = solve_elasticity(p);
@@ -729,15 +758,25 @@ void solve_level(const Scenario& s, LevelResult& r) {
                               : r.solution.reactions[k++]);
     r.solution.reactions = std::move(reactions);
     const std::vector<bool> before = released;
-    if (!update_released_contacts(s.supports, r.support_patches, directions, r.solution, released)) break;
-    for (std::size_t i = 0; i < s.supports.size(); ++i)
-      if (released[i] != before[i])
+    if (!update_released_contacts(s.supports, r.support_patches, r.contact_directions, r.solution, released))
+      break;
+    std::vector<bool> changed(s.supports.size(), false);
+    for (std::size_t i = 0; i < s.supports.size(); ++i) {
+      changed[i] = released[i] != before[i];
+      if (changed[i])
         info("level " + std::to_string(r.level) + ": contact '" + s.supports[i].name +
              (released[i] ? "' would pull the bone: released" : "' touches again: held") + ", solving again");
-    if (seen.count(released) != 0)
-      throw RunError(s.supports.front().where.str() + ": level " + std::to_string(r.level) +
-                     ": the contact supports do not settle (releasing those that pull makes others pull, "
-                     "and back): fix them (remove 'contact') or move their patches");
+    }
+    if (seen.count(released) != 0) {
+      const std::size_t first =
+          static_cast<std::size_t>(std::find(changed.begin(), changed.end(), true) - changed.begin());
+      throw RunError(
+          s.supports[first].where.str() + ": level " + std::to_string(r.level) + ": the contact " +
+          flagged_names(s, changed) +
+          " does not settle: held, it pulls the bone; released, its patch moves into what it touches "
+          "(a patch that tilts: part of it pulls, part pushes): make its patch smaller, or remove "
+          "'contact'");
+    }
   }
   r.seconds_solve = seconds_since(start);
 }
@@ -828,7 +867,21 @@ RunResult prepare_run(Scenario scenario, int levels) {
 
 void solve_run(RunResult& result) {
   const auto start = std::chrono::steady_clock::now();
-  for (LevelResult& level : result.levels) solve_level(result.scenario, level);
+  const Scenario& s = result.scenario;
+  for (LevelResult& level : result.levels) {
+    solve_level(s, level);
+    // The hold measured before the solve was of every support; with contacts released the bone may hang
+    // on a few patches (an opening load lifting the teeth off their contacts): measured again, and
+    // results.json's support_hold is then of the coarse level as solved.
+    std::vector<bool> released(s.supports.size(), false);
+    for (std::size_t i = 0; i < s.supports.size(); ++i) released[i] = level.solution.reactions[i].released;
+    if (std::none_of(released.begin(), released.end(), [](bool b) { return b; })) continue;
+    std::vector<RigidMode> hold =
+        check_support_hold(s, level, split_bodies(level.mesh), released,
+                           "level " + std::to_string(level.level) + ", with the contact " +
+                               flagged_names(s, released) + " released: ");
+    if (level.level == 0) result.support_hold = std::move(hold);
+  }
   result.seconds_total += seconds_since(start);
 }
 

@@ -39,6 +39,7 @@ struct LevelResult {
   std::vector<MeshPatch> muscle_patches;   // the muscles with activation > 0, in scenario order
   std::vector<Vec3> muscle_forces;         // N, total force of each of those muscles
   std::vector<MeshPatch> support_patches;  // every support, in scenario order
+  std::vector<Vec3> contact_directions;    // per support: what a contact resists (app/contact_supports.h)
   std::vector<Vec3> probe_points;          // every probe, moved into the mesh when just outside it
   std::vector<Material> hex_material;      // one per hex
   std::vector<int> region_hexes;  // per material region (scenario order): the hexes it gives its material

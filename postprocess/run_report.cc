@@ -1,5 +1,6 @@
 #include "postprocess/run_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -236,6 +237,25 @@ void validation_section(std::ostringstream& out, const RunFigures& r) {
            "with <code>--levels 1</code> to see.</p>\n";
     return;
   }
+  // A contact released at some levels only: those levels were solved with other supports, and their change
+  // holds that besides the refinement.
+  std::string differs;
+  for (std::size_t i = 0; i < r.levels.front().reactions.size(); ++i) {
+    std::string at;
+    for (const LevelFigures& l : r.levels)
+      if (i < l.reactions.size() && l.reactions[i].released)
+        at += (at.empty() ? "" : ", ") + std::to_string(l.level);
+    const std::size_t count =
+        at.empty() ? 0 : 1 + static_cast<std::size_t>(std::count(at.begin(), at.end(), ','));
+    if (count > 0 && count < r.levels.size())
+      differs +=
+          (differs.empty() ? "" : "; ") + html_escape(r.levels.front().reactions[i].name) + " at level " + at;
+  }
+  if (!differs.empty())
+    out << "<p class=\"note\">Contacts released at some levels only (" << differs
+        << "; a contact that would pull the bone is left out of that level&rsquo;s solve): the changes "
+           "between a "
+           "level with and one without it hold that change of supports, not only the refinement.</p>\n";
   out << "<p>Each change is (level k &minus; level k&minus;1) / |level k|: an estimate of how far the "
          "coarser level&rsquo;s figure is from the value of an ever finer mesh, not of the finer "
          "level&rsquo;s own error (usually smaller) nor of the model&rsquo;s (geometry, material, muscle "

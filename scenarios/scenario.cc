@@ -542,6 +542,13 @@ std::vector<Muscle> parse_activation_pattern(const Source& ctx, const Value& v) 
   return muscles;
 }
 
+// A key's place for messages about its value: the key's, or in a study's variant that set the value
+// (`set: {supports: []}`, `set: {supports.floor.contact: true}`) the study's line, where it was written.
+SourceLocation written_at(const Map& map, const std::string& key) {
+  const Value& v = map.get(key);
+  return !v.node.IsNull() && v.at.file != map.key_at(key).file ? v.at : map.key_at(key);
+}
+
 Support parse_support(const Value& item) {
   const Map map(item, {"name", "at", "radius_mm", "fixed", "spring_N_per_mm3", "bite", "contact"});
   Support s;
@@ -576,9 +583,9 @@ Support parse_support(const Value& item) {
   if (auto x = map.find("bite")) s.bite = to_bool(*x);
   if (auto x = map.find("contact")) s.contact = to_bool(*x);
   if (s.contact && s.spring_N_per_mm3)
-    fail(map.key_at("contact"), "support " + quote(s.name) +
-                                    " is a spring and a contact; a contact is a fixed patch that only "
-                                    "pushes: remove 'contact' or 'spring_N_per_mm3'");
+    fail(written_at(map, "contact"), "support " + quote(s.name) +
+                                         " is a spring and a contact; a contact is a fixed patch that only "
+                                         "pushes: remove 'contact' or 'spring_N_per_mm3'");
   return s;
 }
 
@@ -656,23 +663,16 @@ void check_poisson_for_degree(const Scenario& s) {
                "Poisson's ratio above " + fmt(kMaxPoissonQ1) + ", or use at most " + fmt(kMaxPoissonQ1));
 }
 
-// A list's place for messages about the whole list: its key's, or in a study's variant that set the list
-// (`set: {supports: []}`) the study's line, where the list was written.
-SourceLocation list_at(const Map& root, const std::string& key) {
-  const Value& v = root.get(key);
-  return !v.node.IsNull() && v.at.file != root.key_at(key).file ? v.at : root.key_at(key);
-}
-
 // Checks that can be made before the geometry exists: something loads the bone, something holds it.
 void check_loads_and_supports(const Scenario& s, const Map& root) {
-  const SourceLocation muscles_at = root.has("muscles")              ? list_at(root, "muscles")
-                                    : root.has("activation_pattern") ? list_at(root, "activation_pattern")
+  const SourceLocation muscles_at = root.has("muscles")              ? written_at(root, "muscles")
+                                    : root.has("activation_pattern") ? written_at(root, "activation_pattern")
                                                                      : root.at();
   if (std::none_of(s.muscles.begin(), s.muscles.end(), [](const Muscle& m) { return m.activation > 0; }))
     fail(muscles_at,
          "no muscle is active, so nothing loads the mandible; give at least one muscle an activation "
          "above 0 in 'muscles' or 'activation_pattern'");
-  const SourceLocation supports_at = root.has("supports") ? list_at(root, "supports") : root.at();
+  const SourceLocation supports_at = root.has("supports") ? written_at(root, "supports") : root.at();
   if (s.supports.empty())
     fail(supports_at,
          "the scenario has no supports: nothing holds the mandible, so it could move as a rigid body "

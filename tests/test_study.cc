@@ -268,6 +268,23 @@ TEST(Study, AnEmptyListTheStudySetIsNamedAtTheStudysLine) {
   expect_refused(soft_setting("muscles: []"), 7, "no muscle is active");
 }
 
+// A contact that cannot push (fixed only along its patch's surface) is found when the variants are checked,
+// before any solve: it was found when its variant was solved, after the variants before it.
+TEST(Study, AContactThatCannotPushStopsTheStudyBeforeAnySolve) {
+  const std::string dir =
+      study_folder(kStudy +
+                   "  - name: sliding\n    set:\n      supports:\n"
+                   "        - {name: base, at: [0, 10, 10], radius_mm: 6, bite: true}\n"
+                   "        - {name: slide, at: [10, 10, 0], radius_mm: 5, fixed: [x], contact: true}\n");
+  const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("contact support 'slide' fixes only components along its own surface"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("kept none of its files"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 // A point name is checked once the geometry exists, still before the first solve of any variant.
 TEST(Study, UnknownPointOfTheLastVariantStopsTheStudyBeforeAnySolve) {
   std::string study = kStudy + "  - name: lost\n    set:\n      supports.base.at: nowhere\n";
