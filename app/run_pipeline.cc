@@ -558,9 +558,6 @@ std::array<bool, 3> held_components(const Support& support) {
   return support.fixed;
 }
 
-// Every separate body of the mesh must be held by supports in x, y and z; a body that nothing holds can
-// move freely, the stiffness matrix is singular, and the solve would end in an equilibrium failure with
-// displacements of 1e12 mm. InputError naming the body and the supports' lines.
 // Per body, the components that the supports' patches on it hold; the supports flagged in `left_out` (the
 // released contacts; empty: none) do not count.
 std::vector<std::array<bool, 3>> held_per_body(const Scenario& s, const LevelResult& r, const Bodies& bodies,
@@ -577,6 +574,9 @@ std::vector<std::array<bool, 3>> held_per_body(const Scenario& s, const LevelRes
   return held;
 }
 
+// Every separate body of the mesh must be held by supports in x, y and z; a body that nothing holds can
+// move freely, the stiffness matrix is singular, and the solve would end in an equilibrium failure with
+// displacements of 1e12 mm. InputError naming the body and the supports' lines.
 void require_every_body_held(const Scenario& s, const LevelResult& r, const Bodies& bodies) {
   if (bodies.count < 2) return;
   const std::vector<std::array<bool, 3>> held = held_per_body(s, r, bodies);
