@@ -5,16 +5,11 @@
 #include <set>
 
 #include "common/error.h"
+#include "mesher/vec3.h"
 
 namespace hexbite {
 
-namespace {
-
-double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-}  // namespace
+using vec3::dot;
 
 Vec3 contact_direction(const Support& support, const MeshPatch& patch, const HexMesh& mesh) {
   // Twice a bilinear quad's vector area is the cross product of its diagonals; the boundary quads are
@@ -22,16 +17,12 @@ Vec3 contact_direction(const Support& support, const MeshPatch& patch, const Hex
   Vec3 n{0, 0, 0};
   double area = 0;  // summed magnitudes of the quads' vector areas (twice)
   for (const BoundaryQuad& q : patch.faces) {
-    const Vec3& a = mesh.vertices[q[0]];
-    const Vec3& b = mesh.vertices[q[1]];
-    const Vec3& c = mesh.vertices[q[2]];
-    const Vec3& d = mesh.vertices[q[3]];
-    const Vec3 p{c[0] - a[0], c[1] - a[1], c[2] - a[2]}, r{d[0] - b[0], d[1] - b[1], d[2] - b[2]};
-    const Vec3 face{p[1] * r[2] - p[2] * r[1], p[2] * r[0] - p[0] * r[2], p[0] * r[1] - p[1] * r[0]};
-    for (int k = 0; k < 3; ++k) n[k] += face[k];
-    area += std::sqrt(dot(face, face));
+    const Vec3 face = vec3::cross(vec3::sub(mesh.vertices[q[2]], mesh.vertices[q[0]]),
+                                  vec3::sub(mesh.vertices[q[3]], mesh.vertices[q[1]]));
+    n = vec3::add(n, face);
+    area += vec3::norm(face);
   }
-  const double length = std::sqrt(dot(n, n));
+  const double length = vec3::norm(n);
   // A patch over both sides of a thin part (a plate thinner than the patch) faces both ways: its facets'
   // normals cancel, and what is left of them is no direction (it was taken as one, and a contact pushing
   // on the plate's lower side was released as pulling).
@@ -43,7 +34,7 @@ Vec3 contact_direction(const Support& support, const MeshPatch& patch, const Hex
   Vec3 held{0, 0, 0};
   for (int d = 0; d < 3; ++d)
     if (support.fixed[d] && length > 0) held[d] = n[d] / length;
-  if (!(std::sqrt(dot(held, held)) >= 0.1)) {
+  if (!(vec3::norm(held) >= 0.1)) {
     char faces[96];
     std::snprintf(faces, sizeof faces, "(%.2f, %.2f, %.2f)", length > 0 ? n[0] / length : 0.0,
                   length > 0 ? n[1] / length : 0.0, length > 0 ? n[2] / length : 0.0);
@@ -58,7 +49,7 @@ bool update_released_contacts(const std::vector<Support>& supports, const std::v
                               const std::vector<Vec3>& directions, const ElasticitySolution& solution,
                               std::vector<bool>& released) {
   // Reactions below this share of the loads are the solver's round-off, neither push nor pull.
-  const double noise = 1e-9 * std::sqrt(dot(solution.applied_force, solution.applied_force));
+  const double noise = 1e-9 * vec3::norm(solution.applied_force);
   bool changed = false;
   for (std::size_t i = 0; i < supports.size(); ++i) {
     if (!supports[i].contact) continue;
