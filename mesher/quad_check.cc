@@ -113,6 +113,13 @@ std::string vertex_at(const QuadSurface& surface, int v) {
   return text;
 }
 
+// "quad 5 (vertices 3, 7, 8, 4)".
+std::string quad_at(const QuadSurface& surface, std::size_t q) {
+  const std::array<int, 4>& quad = surface.quads[q];
+  return "quad " + std::to_string(q) + " (vertices " + std::to_string(quad[0]) + ", " +
+         std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) + ")";
+}
+
 // "edge 3-7 of quad 5, from (...) to (...)".
 std::string edge_at(const QuadSurface& surface, const std::array<int, 2>& e, int quad) {
   const Vec3 &a = surface.vertices[static_cast<std::size_t>(e[0])],
@@ -136,10 +143,9 @@ std::string collinear_corners_problem(const QuadSurface& surface) {
       const Vec3 w = vec3::sub(surface.vertices[c], surface.vertices[b]);
       if (vec3::norm(vec3::cross(u, w)) > 1e-12 * vec3::norm(u) * vec3::norm(w)) continue;
       if (flat++ > 0) continue;
-      first = "quad " + std::to_string(q) + " (vertices " + std::to_string(quad[0]) + ", " +
-              std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) +
-              ") has three collinear corners " + std::to_string(a) + ", " + std::to_string(b) + ", " +
-              std::to_string(c) + ": every hex on it has a corner Jacobian of 0 at " + vertex_at(surface, b) +
+      first = quad_at(surface, q) + " has three collinear corners " + std::to_string(a) + ", " +
+              std::to_string(b) + ", " + std::to_string(c) +
+              ": every hex on it has a corner Jacobian of 0 at " + vertex_at(surface, b) +
               " whatever the interior, so no valid hex mesh has this boundary; move that vertex off the line "
               "(make the quad convex)";
     }
@@ -254,10 +260,7 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
     std::array<int, 4> s = quads[q];
     std::sort(s.begin(), s.end());
     if (std::adjacent_find(s.begin(), s.end()) == s.end()) continue;
-    if (r.degenerate_quads++ == 0)
-      first_degenerate = "quad " + std::to_string(q) + " (vertices " + std::to_string(quads[q][0]) + ", " +
-                         std::to_string(quads[q][1]) + ", " + std::to_string(quads[q][2]) + ", " +
-                         std::to_string(quads[q][3]) + ")";
+    if (r.degenerate_quads++ == 0) first_degenerate = quad_at(surface, static_cast<std::size_t>(q));
   }
   {
     std::vector<std::pair<std::array<int, 4>, int>> sorted;
