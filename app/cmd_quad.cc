@@ -5,8 +5,9 @@
 //
 // Reports what the sheet mesher (hexbite mesh --method sheets) needs to know about a quad surface: closed,
 // manifold, genus, even quad count, simple, planar and 3-connected graph, the chords with their lengths and
-// every self-intersecting chord with the quads it crosses twice. The report is printed in full even when the
-// surface is unusable; then every problem also goes to standard error and the exit code is 2.
+// every self-intersecting chord with the quads it crosses twice; then, geometrically, quads that cross each
+// other (mesher/quad_surface_crossings.h) and quad corners on one line. The report is printed in full even
+// when the surface is unusable; then every problem also goes to standard error and the exit code is 2.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>
@@ -24,6 +25,7 @@
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/quad_check.h"
+#include "mesher/quad_surface_crossings.h"
 #include "mesher/quad_surface_io.h"
 
 namespace hexbite {
@@ -35,7 +37,14 @@ struct QuadCheckOptions {
   bool json = false;
 };
 
-nlohmann::json report_json(const QuadSurfaceReport& r) {
+// The geometric test that comes after the combinatorial ones: quads that cross each other. It needs a
+// closed, manifold, consistently oriented surface without degenerate quads; `computed` is false otherwise.
+struct Crossings {
+  bool computed = false;
+  std::vector<std::array<int, 2>> pairs;
+};
+
+nlohmann::json report_json(const QuadSurfaceReport& r, const Crossings& crossings) {
   nlohmann::json j;
   j["file"] = r.file;
   j["quads"] = r.quads;
@@ -70,6 +79,7 @@ nlohmann::json report_json(const QuadSurfaceReport& r) {
     j["chords"] = nullptr;  // undefined on open or non-manifold surfaces
     j["self_intersecting_chords"] = nullptr;
   }
+  j["crossing_quads"] = crossings.computed ? nlohmann::json(crossings.pairs) : nlohmann::json();
   j["problems"] = r.problems;
   j["usable"] = r.usable();
   return j;
@@ -79,7 +89,7 @@ std::string yes_no(bool b) {
   return b ? "yes" : "no";
 }
 
-std::string report_text(const QuadSurfaceReport& r) {
+std::string report_text(const QuadSurfaceReport& r, const Crossings& crossings) {
   std::ostringstream s;
   auto row = [&](const std::string& key, const std::string& value) {
     s << "  " << key << std::string(key.size() < 22 ? 22 - key.size() : 1, ' ') << value << '\n';
@@ -102,6 +112,11 @@ std::string report_text(const QuadSurfaceReport& r) {
   row("simple graph", yes_no(r.simple));
   row("planar graph", yes_no(r.planar));
   row("3-connected", yes_no(r.three_connected));
+  row("crosses itself", !crossings.computed ? std::string("not tested (needs a closed, oriented manifold)")
+                        : crossings.pairs.empty()
+                            ? std::string("no")
+                            : "yes (" + std::to_string(crossings.pairs.size()) +
+                                  (crossings.pairs.size() == 1 ? " pair" : " pairs") + " of quads)");
   if (r.chords_computed) {
     // Lengths as a histogram keeps the line short for surfaces with hundreds of chords.
     std::map<int, int> lengths;
@@ -135,10 +150,19 @@ void run_quad_check(const QuadCheckOptions& o) {
   if (report.closed && report.manifold)
     if (const std::string flat = collinear_corners_problem(surface); !flat.empty())
       report.problems.push_back(flat);
+  // A surface folded over itself passes every combinatorial test, and the mesh command then left hexes
+  // inverted.
+  Crossings crossings;
+  if (report.closed && report.manifold && report.consistently_oriented && report.degenerate_quads == 0) {
+    crossings.computed = true;
+    crossings.pairs = crossing_quads(surface);
+    if (const std::string crossing = crossing_quads_problem(surface, crossings.pairs); !crossing.empty())
+      report.problems.push_back(crossing + ": " + kUntangleQuadSurface);
+  }
   if (o.json)
-    std::cout << json_text(report_json(report)) << std::endl;
+    std::cout << json_text(report_json(report, crossings)) << std::endl;
   else
-    info(report_text(report));
+    info(report_text(report, crossings));
   if (!report.usable()) {
     for (const auto& p : report.problems) std::cerr << "hexbite: error: '" << o.file << "': " << p << '\n';
     throw InputError("'" + o.file + "' cannot bound a hex mesh by cycle elimination (" +

@@ -12,6 +12,7 @@
 #include "mesher/cycle_elimination.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
+#include "mesher/quad_surface_crossings.h"
 #include "mesher/quad_surface_io.h"
 #include "postprocess/quality_json.h"
 
@@ -54,6 +55,17 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
         "Q.obj (a quad surface of a ball)");
   const EliminationOrder order = parse_elimination_order(o.order);
   const QuadSurface surface = read_quad_surface(o.quad_surface);
+  // A folded surface passes the elimination's combinatorial tests and leaves hexes inverted after the
+  // whole run; it is refused first (--allow-invalid meshes it anyway, and the crossing is named as a
+  // warning).
+  if (const std::string crossing = crossing_quads_problem(surface, crossing_quads(surface));
+      !crossing.empty()) {
+    if (!o.allow_invalid)
+      throw InputError("'" + o.quad_surface + "': " + crossing + ": " + kUntangleQuadSurface +
+                       " (--allow-invalid meshes it anyway)");
+    std::cerr << "hexbite: warning: '" << o.quad_surface << "': " << crossing
+              << " (meshing it anyway: --allow-invalid)\n";
+  }
   SheetMeshOptions options;
   options.elimination.order = order;
   SheetMeshReport report;
@@ -84,9 +96,9 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
     throw RunError(
         std::to_string(report.quality.inverted) +
         " hexes stay inverted after optimization: " + hex_list_text(mesh, report.quality.inverted_hexes) +
-        "; the quad surface may fold over itself there (quads that cross each other bound no solid): "
-        "check it, or mesh the solid with --method grid; no mesh written (--allow-invalid writes it "
-        "anyway)");
+        "; a quad corner there may be reflex (a non-convex quad: no hex on it has a positive Jacobian at "
+        "that corner) or the quads too bent for the hexes under them: check the quad surface there, or mesh "
+        "the solid with --method grid; no mesh written (--allow-invalid writes it anyway)");
   if (!o.json) info("wrote " + o.output);
 }
 

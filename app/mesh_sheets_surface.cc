@@ -245,7 +245,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   const SheetMeshReport& report = sheet_report.sheets;
   const MeshFidelity& fidelity = sheet_report.fidelity;
   const double total_seconds = seconds_since(t0);
-  const bool valid = sheet_report.inverted == 0;
+  const bool valid = sheet_report.inverted == 0 && sheet_report.boundary_crossings.empty();
   const bool write = valid || o.allow_invalid;
   if (write) write_hex_mesh(qo.output, mesh);
   const QualitySummary& q = report.quality;
@@ -260,6 +260,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     j["local_refinement"] = refinement_json(qo.refine, sheet_report.refinement);
     add_sheet_report_json(report, j);
     j["pillow_hexes"] = sheet_report.pillow_hexes;
+    j["boundary_crossings"] = sheet_report.boundary_crossings.size();
     j["seconds"] = {{"quad_surface", quad_report.seconds},
                     {"elimination", report.seconds_elimination},
                     {"embedding", report.seconds_embedding},
@@ -299,7 +300,13 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     out << line;
     std::cout << out.str();
   }
-  if (!valid && !o.allow_invalid)
+  if (!sheet_report.boundary_crossings.empty()) {
+    const std::string text =
+        sheet_report.boundary_crossing_text + "; ask for fewer hexes, or use --method grid";
+    if (!o.allow_invalid) throw RunError(text + "; no mesh written (--allow-invalid writes it anyway)");
+    std::cerr << "hexbite: warning: wrote " << qo.output << " on purpose (--allow-invalid): " << text << '\n';
+  }
+  if (sheet_report.inverted > 0 && !o.allow_invalid)
     throw RunError(std::to_string(q.inverted) +
                    " hexes stay inverted after optimization: " + hex_list_text(mesh, q.inverted_hexes) +
                    "; no mesh written (--allow-invalid writes it anyway)");

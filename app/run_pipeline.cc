@@ -234,6 +234,9 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
         report.refinement.quads_added);
     info(line);
   }
+  if (!report.boundary_crossings.empty())
+    throw RunError("the sheet mesher's mesh at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
+                   ": " + report.boundary_crossing_text + "; try a smaller target or method: grid");
   if (report.inverted > 0)
     throw RunError("the sheet mesher left " + std::to_string(report.inverted) +
                    " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) + ": " +

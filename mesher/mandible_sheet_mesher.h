@@ -23,11 +23,14 @@
 //      (MandibleQuadReport::landmark_vertices) stay fixed; then the worst-element pass (threshold 0.3, 10
 //      scaled-Jacobian sweeps, two rounds) and the mean stage (10 sweeps raising the mean scaled Jacobian
 //      without lowering the worst).
-//   5. Quality and fidelity (measure_fidelity, mesher/grid_mesher.h) of the final mesh against the input.
+//   5. Quality and fidelity (measure_fidelity, mesher/grid_mesher.h) of the final mesh against the input,
+//      and the boundary quads that cross each other (mesher/quad_surface_crossings.h).
 // Output: the mesh (vertices 0 .. quads' vertices - 1 are the boundary, in the quad surface's order) and a
-// report. Hexes left inverted are reported (MandibleSheetReport::inverted), not thrown: the caller decides.
+// report. Hexes left inverted and a boundary that crosses itself are reported (MandibleSheetReport::inverted,
+// boundary_crossings), not thrown: the caller decides.
 // Failure: InputError "NAME: ..." when the landmarks lack the points the template needs, the surface is not
-// mandible-like or the target is out of range; RunError when the quad surface fails its check or the cycle
+// mandible-like or the target is out of range; RunError when the quad surface fails its check (crossing
+// itself included: the template folds over thin parts at high densities) or the cycle
 // elimination gets stuck (a defect of the template or its placement, not of the input). NAME is
 // MandibleSheetOptions::surface_name.
 // Cost: the quad surface's (quad_surface_placement.h) plus elimination and optimization, O(m) per sweep
@@ -47,6 +50,7 @@
 #include "mesher/landmarks.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_local_refinement.h"
+#include "mesher/quad_surface_crossings.h"
 #include "mesher/quad_surface_placement.h"
 
 namespace hexbite {
@@ -73,6 +77,10 @@ struct MandibleSheetReport {
   MeshFidelity fidelity;  // the final (slid, and with fit_volume fitted) boundary against the input
   std::optional<BoundaryFitReport> volume_fit;  // with MandibleSheetOptions::fit_volume
   int inverted = 0;  // hexes left inverted; sheets.quality.inverted_hexes lists them
+  // Pairs of boundary quads of the final mesh that cross each other (mesher/quad_surface_crossings.h), and
+  // the message naming the first ("" when none): the hexes there overlap, so the mesh is invalid too.
+  std::vector<std::array<int, 2>> boundary_crossings;
+  std::string boundary_crossing_text;
 };
 
 // Step 1 alone (`hexbite quad from-mandible`): the quad surface of about target_quads quads, refined

@@ -59,10 +59,11 @@ Csr make_csr(int n, const std::vector<std::array<int, 2>>& edges) {
   return g;
 }
 
-// True when the active vertices other than `removed` form a connected graph without articulation points.
-// Iterative Tarjan low-point search; the work arrays are passed in so that the n calls of the
-// 3-connectivity test do not allocate.
-bool biconnected_without(const Csr& g, int removed, std::vector<int>& disc, std::vector<int>& low,
+// -1 when the active vertices other than `removed` form a connected graph without articulation points;
+// else an articulation point of that graph (removing it too disconnects the graph), or -2 when the graph
+// without `removed` is not connected. Iterative Tarjan low-point search; the work arrays are passed in so
+// that the n calls of the 3-connectivity test do not allocate.
+int articulation_without(const Csr& g, int removed, std::vector<int>& disc, std::vector<int>& low,
                          std::vector<std::array<int, 2>>& stack) {
   std::fill(disc.begin(), disc.end(), -1);
   int root = -1;
@@ -71,7 +72,7 @@ bool biconnected_without(const Csr& g, int removed, std::vector<int>& disc, std:
       root = v;
       break;
     }
-  if (root < 0) return true;
+  if (root < 0) return -1;
   int time = 0;
   int root_children = 0;
   disc[root] = low[root] = time++;
@@ -96,13 +97,12 @@ bool biconnected_without(const Csr& g, int removed, std::vector<int>& disc, std:
       const int parent = stack.back()[0];
       low[parent] = std::min(low[parent], low[child]);
       // A non-root vertex is an articulation point when some child cannot reach above it.
-      if (parent != root && low[child] >= disc[parent]) return false;
+      if (parent != root && low[child] >= disc[parent]) return parent;
     }
   }
-  if (root_children > 1) return false;
   for (int v : g.active)
-    if (v != removed && disc[v] < 0) return false;  // disconnected
-  return true;
+    if (v != removed && disc[v] < 0) return -2;  // disconnected
+  return root_children > 1 ? root : -1;
 }
 
 // "vertex 4 at (0.5, 0, 0.5)": a vertex by its 0-based index and its place.
@@ -222,15 +222,25 @@ bool is_planar_graph(int n, const std::vector<std::array<int, 2>>& edges) {
   return boost::boyer_myrvold_planarity_test(g);
 }
 
-bool is_three_connected(int n, const std::vector<std::array<int, 2>>& edges) {
+bool is_three_connected(int n, const std::vector<std::array<int, 2>>& edges, std::vector<int>* separator) {
   const Csr g = make_csr(n, edges);
   if (g.active.size() < 4) return false;
   std::vector<int> disc(static_cast<std::size_t>(n)), low(static_cast<std::size_t>(n));
   std::vector<std::array<int, 2>> stack;
   for (int v : g.active)
-    if (g.start[v + 1] - g.start[v] < 3) return false;  // its neighbours separate it
+    if (g.start[v + 1] - g.start[v] < 3) {  // its neighbours separate it
+      if (separator) {
+        separator->assign(g.adj.begin() + g.start[v], g.adj.begin() + g.start[v + 1]);
+        std::sort(separator->begin(), separator->end());
+      }
+      return false;
+    }
   for (int removed : g.active)
-    if (!biconnected_without(g, removed, disc, low, stack)) return false;
+    if (const int cut = articulation_without(g, removed, disc, low, stack); cut != -1) {
+      if (separator && cut >= 0) *separator = {std::min(removed, cut), std::max(removed, cut)};
+      if (separator && cut == -2) *separator = {removed};
+      return false;
+    }
   return true;
 }
 
@@ -341,7 +351,7 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   r.simple = r.degenerate_quads == 0 && r.quad_pairs_sharing_edges == 0 && r.duplicate_quads == 0 &&
              r.non_manifold_edges == 0;
   r.planar = is_planar_graph(nv, qe.edges);
-  r.three_connected = is_three_connected(nv, qe.edges);
+  r.three_connected = is_three_connected(nv, qe.edges, &r.separator);
   if (r.closed && r.non_manifold_edges == 0 && r.degenerate_quads == 0) {
     r.chords_computed = true;
     r.chords = find_chords(quads, qe);
@@ -403,10 +413,17 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
                          " two or more edges, " +
                          count(r.duplicate_quads, "duplicate quad", "duplicate quads") +
                          (first_duplicate.empty() ? "" : " (the first: " + first_duplicate + ")"));
-  if (r.ball && r.simple && !r.three_connected)
-    r.problems.push_back(
-        "graph not 3-connected: removing two vertices disconnects it (a vertex of degree 2 "
-        "or a pinch); the elimination needs a 3-connected graph");
+  if (r.ball && r.simple && !r.three_connected) {
+    std::string which = "two vertices";
+    if (!r.separator.empty()) {
+      which = vertex_at(surface, r.separator[0]);
+      for (std::size_t i = 1; i < r.separator.size(); ++i)
+        which += " and " + vertex_at(surface, r.separator[i]);
+    }
+    r.problems.push_back("graph not 3-connected: removing " + which +
+                         " disconnects it (a vertex of degree 2 or a pinch); the elimination needs a "
+                         "3-connected graph");
+  }
   for (int c : r.self_intersecting_chords) {
     const Chord& ch = r.chords[c];
     std::string quads_text;

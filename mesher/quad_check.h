@@ -81,9 +81,12 @@ struct Chord {
 std::vector<Chord> find_chords(const std::vector<std::array<int, 4>>& quads, const QuadEdges& edges);
 
 // Graph tests on vertices 0..n-1 with the given undirected edges (no duplicates). Isolated vertices are
-// ignored. The 3-connectivity test needs at least 4 non-isolated vertices.
+// ignored. The 3-connectivity test needs at least 4 non-isolated vertices; when it fails and `separator` is
+// given, that gets the vertices (one or two) whose removal disconnects the graph (a vertex of degree below
+// 3: its neighbours), or stays empty when the graph is too small or not connected at all.
 bool is_planar_graph(int n, const std::vector<std::array<int, 2>>& edges);
-bool is_three_connected(int n, const std::vector<std::array<int, 2>>& edges);
+bool is_three_connected(int n, const std::vector<std::array<int, 2>>& edges,
+                        std::vector<int>* separator = nullptr);
 
 struct QuadSurfaceReport {
   std::string file;
@@ -109,6 +112,7 @@ struct QuadSurfaceReport {
   int duplicate_quads = 0;           // quads with the same vertices as an earlier quad
   bool planar = false;
   bool three_connected = false;
+  std::vector<int> separator;    // when not 3-connected: one or two vertices whose removal disconnects it
   bool chords_computed = false;  // only for closed manifold surfaces without degenerate quads
   std::vector<Chord> chords;
   std::vector<int> self_intersecting_chords;  // indices into chords

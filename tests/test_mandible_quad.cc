@@ -3,6 +3,8 @@
 // `hexbite mesh SURFACE --method sheets`.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -323,14 +325,18 @@ TEST(MandibleQuadsCli, FromMandibleWritesACheckedQuadSurface) {
   const auto check = test::run_hexbite({"quad", "check", dir + "/q.obj"});
   EXPECT_EQ(check.exit_code, 0) << check.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
-  // Another mandible's landmark file still places the template, but not silently.
+  // Another mandible's landmark file is named in a warning. The template it places on this mandible folds
+  // over the right ramus (8 pairs of quads cross each other): that surface was written with exit 0.
   const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
   const auto other = test::run_hexbite(
       {"quad", "from-mandible", dir + "/m.stl", "--landmarks", jaw_file, "-o", dir + "/q2.obj", "--quiet"});
-  EXPECT_EQ(other.exit_code, 0) << other.err;
+  EXPECT_EQ(other.exit_code, 1) << other.err;
   EXPECT_NE(other.err.find("hexbite: warning: landmark file " + jaw_file + ": its 18 muscle insertions lie"),
             std::string::npos)
       << other.err;
+  EXPECT_NE(other.err.find("the surface crosses itself"), std::string::npos) << other.err;
+  EXPECT_NE(other.err.find("when the landmarks do not fit the surface"), std::string::npos) << other.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/q2.obj"));
 }
 
 TEST(MandibleQuadsCli, BadLandmarkFilesExitWithCode2AndNameTheFile) {
@@ -348,6 +354,23 @@ TEST(MandibleQuadsCli, BadLandmarkFilesExitWithCode2AndNameTheFile) {
   EXPECT_NE(few.err.find("right_condyle_tmj_point"), std::string::npos) << few.err;
   EXPECT_FALSE(std::ifstream(dir + "/q.obj").good());
   EXPECT_FALSE(std::ifstream(dir + "/m.vtu").good());
+}
+
+// At 3,000 quads the placed template folds over a thin part of the built-in mandible (8 pairs of quads
+// cross each other near (-38, 11, 35) mm). `quad from-mandible` wrote that surface with exit 0, and `mesh
+// --method sheets` at such sizes wrote a mesh whose boundary crossed itself; both now fail (exit 1), naming
+// the place, and write nothing.
+TEST(MandibleQuadsCli, AQuadSurfaceThatCrossesItselfIsAFailedRun) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(test::run_hexbite({"generate", "mandible", "-o", dir + "/m.stl", "--landmarks", dir + "/m.yaml"})
+                .exit_code,
+            0);
+  const auto r = test::run_hexbite({"quad", "from-mandible", dir + "/m.stl", "--landmarks", dir + "/m.yaml",
+                                    "--target-quads", "3000", "-o", dir + "/q.obj"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("quads): the surface crosses itself: quads "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ask for fewer quads or hexes"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/q.obj"));
 }
 
 // The whole command on a mandible: a valid mesh (no --allow-invalid) within the size and degree

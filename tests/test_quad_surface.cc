@@ -2,6 +2,7 @@
 // 3-connected, chords) and `hexbite quad check`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/quad_check.h"
+#include "mesher/quad_surface_crossings.h"
 #include "mesher/quad_surface_io.h"
 #include "tests/quad_test_surfaces.h"
 #include "tests/test_util.h"
@@ -68,11 +70,15 @@ TEST(QuadCheck, GraphTests) {
   const std::vector<std::array<int, 2>> k4 = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   EXPECT_TRUE(is_three_connected(4, k4));
   EXPECT_TRUE(is_planar_graph(4, k4));
-  // A 6-cycle with one chord is 2-connected only.
-  EXPECT_FALSE(is_three_connected(6, {{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 5}, {5, 0}, {0, 3}}));
-  // Two K4 glued at two vertices {0, 1}: removing 0 and 1 separates them.
+  // A 6-cycle with one chord is 2-connected only: vertex 1's neighbours 0 and 2 separate it.
+  std::vector<int> separator;
+  EXPECT_FALSE(is_three_connected(6, {{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 5}, {5, 0}, {0, 3}}, &separator));
+  EXPECT_EQ(separator, (std::vector<int>{0, 2}));
+  // Two K4 glued at two vertices {0, 1}: removing 0 and 1 separates them (all degrees are at least 3).
   EXPECT_FALSE(is_three_connected(
-      6, {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}, {0, 4}, {0, 5}, {1, 4}, {1, 5}, {4, 5}}));
+      6, {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}, {0, 4}, {0, 5}, {1, 4}, {1, 5}, {4, 5}},
+      &separator));
+  EXPECT_EQ(separator, (std::vector<int>{0, 1}));
   std::vector<std::array<int, 2>> k5;
   for (int a = 0; a < 5; ++a)
     for (int b = a + 1; b < 5; ++b) k5.push_back({a, b});
@@ -409,22 +415,111 @@ TEST(QuadCheckCli, ExitCodesAndMessages) {
   }
 }
 
-// A 3 x 1 x 1 box whose top vertices over x = 1 and 2 are pulled below the bottom: the quads fold over
-// themselves. The sheet mesher's hexes stay inverted (exit 1); the message named no hex, and the quality
-// line printed "nan" for the condition numbers it could not take.
-TEST(MeshSheetsCli, InvertedHexesAreNamedWithTheirPlaces) {
+// A 3 x 1 x 1 box whose top vertices over x = 1 and 2 on the front are pulled below the bottom: the quads
+// fold over themselves, which every combinatorial test passes.
+QuadSurface folded_box() {
   QuadSurface fold = test::block_surface(3, 1, 1);
   for (Vec3& v : fold.vertices)
     if (v[1] == 0 && v[2] == 1 && (v[0] == 1 || v[0] == 2)) v[2] = -0.5;
+  return fold;
+}
+
+TEST(QuadCrossings, FoldedSurfacesAndPlainOnes) {
+  EXPECT_TRUE(crossing_quads(test::block_surface(3, 2, 2)).empty());
+  EXPECT_EQ(crossing_quads_problem(test::block_surface(3, 2, 2), {}), "");
+  const QuadSurface fold = folded_box();
+  const std::vector<std::array<int, 2>> pairs = crossing_quads(fold);
+  ASSERT_FALSE(pairs.empty());
+  EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
+  for (const auto& [a, b] : pairs) {
+    EXPECT_LE(a, b);
+    EXPECT_LT(b, static_cast<int>(fold.quads.size()));
+  }
+  const std::string text = crossing_quads_problem(fold, pairs);
+  // The first pair is a quad whose two halves cross (the corner pulled below the bottom bends it over).
+  ASSERT_EQ(pairs[0][0], pairs[0][1]);
+  EXPECT_EQ(text.find("the surface crosses itself: quad " + std::to_string(pairs[0][0]) +
+                      " (centre (0.5, 0, 0.125)) is folded: its two halves cross"),
+            0u)
+      << text;
+  EXPECT_NE(std::find_if(pairs.begin(), pairs.end(), [](const auto& p) { return p[0] != p[1]; }),
+            pairs.end());
+  EXPECT_NE(text.find(std::to_string(pairs.size()) + " crossing pairs in all"), std::string::npos) << text;
+  // An open surface is tested too (quad check reports it as open first and does not ask).
+  QuadSurface open = fold;
+  open.quads.pop_back();
+  EXPECT_FALSE(crossing_quads(open).empty());
+}
+
+// quad check passed a folded surface as "usable for --method sheets: yes", and `mesh` then left hexes
+// inverted after the whole run. Now a problem, with `crossing_quads` in the JSON (null when not tested).
+TEST(QuadCheckCli, FoldedSurfaceCrossesItself) {
   const std::string dir = test::temp_dir();
-  write_quad_obj(dir + "/fold.obj", fold);
+  write_quad_obj(dir + "/fold.obj", folded_box());
+  write_quad_obj(dir + "/box.obj", test::block_surface(3, 1, 1));
+  const auto fold = test::run_hexbite({"quad", "check", dir + "/fold.obj", "--json"});
+  EXPECT_EQ(fold.exit_code, 2) << fold.err;
+  const auto j = nlohmann::json::parse(fold.out);
+  EXPECT_FALSE(j["usable"].get<bool>());
+  EXPECT_GT(j["crossing_quads"].size(), 0u);
+  EXPECT_NE(fold.err.find("fold.obj': the surface crosses itself: quad 1 (centre (0.5, 0, 0.125)) is folded"),
+            std::string::npos)
+      << fold.err;
+  EXPECT_NE(fold.err.find("untangle the surface there"), std::string::npos) << fold.err;
+  const auto box = test::run_hexbite({"quad", "check", dir + "/box.obj", "--json"});
+  EXPECT_EQ(box.exit_code, 0) << box.err;
+  EXPECT_TRUE(nlohmann::json::parse(box.out)["crossing_quads"].is_array());
+  EXPECT_EQ(nlohmann::json::parse(box.out)["crossing_quads"].size(), 0u);
+  const auto text = test::run_hexbite({"quad", "check", dir + "/box.obj"});
+  EXPECT_NE(text.out.find("crosses itself        no"), std::string::npos) << text.out;
+  QuadSurface open = test::block_surface(3, 1, 1);
+  open.quads.pop_back();
+  write_quad_obj(dir + "/open.obj", open);
+  EXPECT_TRUE(nlohmann::json::parse(
+                  test::run_hexbite({"quad", "check", dir + "/open.obj", "--json"}).out)["crossing_quads"]
+                  .is_null());
+}
+
+// The sheet mesher refuses a folded quad surface before the work (it left hexes inverted, exit 1, after
+// it); --allow-invalid meshes it anyway, saying so.
+TEST(MeshSheetsCli, FoldedQuadSurfaceIsRefusedFirst) {
+  const std::string dir = test::temp_dir();
+  write_quad_obj(dir + "/fold.obj", folded_box());
   const auto r = test::run_hexbite(
       {"mesh", "--quad-surface", dir + "/fold.obj", "--method", "sheets", "-o", dir + "/fold.vtu"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("fold.obj': the surface crosses itself: quad 1 "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--allow-invalid meshes it anyway"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("Meshed"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/fold.vtu"));
+  const auto anyway = test::run_hexbite({"mesh", "--quad-surface", dir + "/fold.obj", "--method", "sheets",
+                                         "-o", dir + "/fold.vtu", "--allow-invalid"});
+  EXPECT_EQ(anyway.exit_code, 0) << anyway.err;
+  EXPECT_NE(anyway.err.find("hexbite: warning: '" + dir + "/fold.obj': the surface crosses itself"),
+            std::string::npos)
+      << anyway.err;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/fold.vtu"));
+}
+
+// A 2 x 2 x 1 box whose top centre vertex is moved within the top face next to a corner: one top quad is
+// non-convex (a reflex corner), the surface does not cross itself, and every hex on that quad is inverted at
+// the reflex corner. The message named no hex, and the quality line printed "nan" for the condition
+// numbers it could not take.
+TEST(MeshSheetsCli, InvertedHexesAreNamedWithTheirPlaces) {
+  QuadSurface dart = test::block_surface(2, 2, 1);
+  for (Vec3& v : dart.vertices)
+    if (v[0] == 1 && v[1] == 1 && v[2] == 1) v = {0.1, 0.1, 1};
+  ASSERT_TRUE(crossing_quads(dart).empty());
+  const std::string dir = test::temp_dir();
+  write_quad_obj(dir + "/dart.obj", dart);
+  const auto r = test::run_hexbite(
+      {"mesh", "--quad-surface", dir + "/dart.obj", "--method", "sheets", "-o", dir + "/dart.vtu"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("hexes stay inverted after optimization: hex "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(") mm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("may be reflex"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
-  EXPECT_FALSE(std::filesystem::exists(dir + "/fold.vtu"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/dart.vtu"));
 }
 
 // `quad from-mesh` writes the boundary quads of a hex mesh (.vtu or .msh): for a 2 x 3 x 4 block its 52
