@@ -59,10 +59,13 @@ std::vector<MeshArray> permute_arrays(const std::vector<MeshArray>& arrays, cons
       continue;
     MeshArray p = a;
     p.values.clear();
-    p.values.reserve(a.values.size());
+    p.bits64.clear();
     for (int i : order)
-      for (int c = 0; c < a.components; ++c)
-        p.values.push_back(a.values[static_cast<std::size_t>(i) * a.components + c]);
+      for (int c = 0; c < a.components; ++c) {
+        const std::size_t k = static_cast<std::size_t>(i) * a.components + c;
+        p.values.push_back(a.values[k]);
+        if (!a.bits64.empty()) p.bits64.push_back(a.bits64[k]);
+      }
     out.push_back(std::move(p));
   }
   return out;

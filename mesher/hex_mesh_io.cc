@@ -132,12 +132,21 @@ void check_arrays(const std::vector<MeshArray>& arrays, std::size_t count, const
 
 static_assert(VTK_DOUBLE == 11, "MeshArray::vtk_type's default is VTK_DOUBLE");
 
+// VTK's 64-bit integer types on this platform, whose values a double cannot always hold.
+bool is_64_bit_integer(const vtkDataArray& a) {
+  return a.GetDataTypeSize() == 8 && a.GetDataType() != VTK_DOUBLE;
+}
+
 vtkSmartPointer<vtkDataArray> make_vtk_array(const MeshArray& a) {
   vtkSmartPointer<vtkDataArray> array;
   array.TakeReference(vtkDataArray::CreateDataArray(a.vtk_type));
   array->SetName(a.name.c_str());
   array->SetNumberOfComponents(a.components);
   array->SetNumberOfTuples(static_cast<vtkIdType>(a.values.size() / a.components));
+  if (!a.bits64.empty() && is_64_bit_integer(*array) && a.bits64.size() == a.values.size()) {
+    std::memcpy(array->GetVoidPointer(0), a.bits64.data(), a.bits64.size() * sizeof(std::uint64_t));
+    return array;
+  }
   for (std::size_t i = 0; i < a.values.size(); ++i)
     array->SetComponent(static_cast<vtkIdType>(i / a.components), static_cast<int>(i % a.components),
                         a.values[i]);
@@ -156,6 +165,10 @@ std::vector<MeshArray> arrays_of(vtkFieldData* data) {
     m.values.resize(static_cast<std::size_t>(a->GetNumberOfTuples()) * m.components);
     for (vtkIdType t = 0; t < a->GetNumberOfTuples(); ++t)
       for (int c = 0; c < m.components; ++c) m.values[t * m.components + c] = a->GetComponent(t, c);
+    if (is_64_bit_integer(*a) && !m.values.empty()) {  // the XML reader's arrays are contiguous
+      m.bits64.resize(m.values.size());
+      std::memcpy(m.bits64.data(), a->GetVoidPointer(0), m.bits64.size() * sizeof(std::uint64_t));
+    }
     out.push_back(std::move(m));
   }
   return out;

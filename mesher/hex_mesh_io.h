@@ -10,6 +10,7 @@
 // Cost: linear in the mesh size.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct MeshArray {
   int components = 1;
   std::vector<double> values;
   int vtk_type = 11;
+  // For a 64-bit integer type (signed or unsigned), the values exactly, as their 64 bits: a double holds
+  // integers up to 2^53 only, and `reorder` wrote 123456789012345679 back as ...680. When not empty, the
+  // writer takes these instead of `values` (which hold the same numbers rounded).
+  std::vector<std::uint64_t> bits64;
 };
 
 // A named set of 0-based node or element indices, for solver input files.

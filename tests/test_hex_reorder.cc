@@ -228,6 +228,41 @@ TEST(HexReorderCommand, ArraysKeepTheirValuesAndTypes) {
   EXPECT_NE(text.find("type=\"Int64\" Name=\"node_id\""), std::string::npos);
 }
 
+// 64-bit integer ids above 2^53 come through exactly: they went through doubles, so 2^60 + 1 came out as
+// 2^60 and 2^64 - 1 as 0, with exit 0.
+TEST(HexReorderCommand, SixtyFourBitIntegersKeepEveryDigit) {
+  const std::string dir = temp_dir();
+  const HexMesh mesh = shuffled(make_block_mesh(2, 2, 2), 3);
+  MeshArray big{"big", 1, {}, VTK_LONG_LONG}, ubig{"ubig", 1, {}, VTK_UNSIGNED_LONG_LONG};
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    big.bits64.push_back((std::uint64_t{1} << 60) + h);
+    big.values.push_back(std::ldexp(1.0, 60));
+  }
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    ubig.bits64.push_back(~std::uint64_t{0} - v);
+    ubig.values.push_back(std::ldexp(1.0, 64));
+  }
+  write_vtu(dir + "/in.vtu", mesh, {big}, {ubig});
+  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<MeshArray> cells, points;
+  read_vtu(dir + "/rcm.vtu", &cells, &points);
+  const ReorderResult expected = reorder_reverse_cuthill_mckee(mesh);
+  const auto named = [](const std::vector<MeshArray>& arrays, const std::string& name) {
+    const auto it =
+        std::find_if(arrays.begin(), arrays.end(), [&](const MeshArray& a) { return a.name == name; });
+    return it == arrays.end() ? MeshArray{} : *it;
+  };
+  const MeshArray cell = named(cells, "big"), point = named(points, "ubig");
+  ASSERT_EQ(cell.bits64.size(), mesh.hexes.size());
+  ASSERT_EQ(point.bits64.size(), mesh.vertices.size());
+  for (std::size_t i = 0; i < expected.hex_order.size(); ++i)
+    EXPECT_EQ(cell.bits64[i], (std::uint64_t{1} << 60) + static_cast<std::uint64_t>(expected.hex_order[i]));
+  for (std::size_t i = 0; i < expected.node_order.size(); ++i)
+    EXPECT_EQ(point.bits64[i], ~std::uint64_t{0} - static_cast<std::uint64_t>(expected.node_order[i]));
+  EXPECT_EQ(point.vtk_type, VTK_UNSIGNED_LONG_LONG);
+}
+
 // What reorder cannot carry (text arrays, field data) is named in a warning: it was dropped without a word.
 TEST(HexReorderCommand, WhatIsNotCarriedOverIsNamed) {
   const std::string dir = temp_dir();
