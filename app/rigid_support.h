@@ -46,7 +46,7 @@ struct RigidMode {
 
 // Below this rho the supports resist a rigid motion only by the extent of their patches, and the
 // displacements and stresses mostly measure that motion. Measured on the built-in mandible at 4,000 hexes
-// (docs/scenario-format.md "Supports"): the shipped scenarios 0.52 to 1.28; a bite patch fixed in z with
+// (docs/scenario-format.md "Supports"): the shipped scenarios 0.33 to 1.28; a bite patch fixed in z with
 // the condyles in x and y 0.0031 (largest displacement 2.9 mm, against 0.12 mm with every component
 // fixed), the condyles alone 0.0067 (11 mm), a bite and one condyle 0.012 (3.9 mm). A 100 mm box clamped
 // over one patch of 20 mm radius, a proper cantilever, has 0.035 and is not weak.

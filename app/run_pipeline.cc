@@ -649,7 +649,7 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
                   m.direction[2]);
     char hold[256];
     std::snprintf(hold, sizeof hold,
-                  " (hold %.2g, below %.2g; the shipped scenarios 0.52 to 1.28), so the displacements and "
+                  " (hold %.2g, below %.2g; the shipped scenarios 0.33 to 1.28), so the displacements and "
                   "stresses mostly measure that motion; fix more components of a support, or add a support "
                   "away from that axis",
                   m.rho, kWeakSupportHold);

@@ -84,13 +84,14 @@ double to_number(const Value& v) {
   return x;
 }
 
-int to_int(const Value& v) {
+// A whole number of any size (up to 2^53); the callers check their ranges on it, so that 1e10 is "out of
+// range" and not "not a whole number" (an int, as before, could not hold it).
+long long to_whole(const Value& v) {
   long long x = 0;
-  if (!decimal_whole_number(v.node, &x) || x < std::numeric_limits<int>::min() ||
-      x > std::numeric_limits<int>::max())
+  if (!decimal_whole_number(v.node, &x))
     fail(v.at, v.path + " must be a whole number, found " + describe(v.node) +
                    "; write it in decimal digits, without quotes");
-  return static_cast<int>(x);
+  return x;
 }
 
 bool to_bool(const Value& v) {
@@ -294,19 +295,21 @@ MeshSettings parse_mesh(const Value& v) {
     m.method_at = x->at;
   }
   if (auto x = map.find("target_hexes")) {
-    m.target_hexes = to_int(*x);
-    if (m.target_hexes < kMinTargetHexes || m.target_hexes > kMaxTargetHexes)
-      fail(x->at, "mesh.target_hexes is " + std::to_string(m.target_hexes) + " but must be from " +
+    const long long n = to_whole(*x);
+    if (n < kMinTargetHexes || n > kMaxTargetHexes)
+      fail(x->at, "mesh.target_hexes is " + std::to_string(n) + " but must be from " +
                       std::to_string(kMinTargetHexes) + " to " + std::to_string(kMaxTargetHexes) +
-                      "; the default is 2500, and the built-in mandible keeps its condyles from about 4000");
+                      "; the default is 2500, at which the built-in mandible keeps its condyles");
+    m.target_hexes = static_cast<int>(n);
   }
   if (auto x = map.find("validation_levels")) {
-    m.validation_levels = to_int(*x);
+    const long long n = to_whole(*x);
     m.validation_levels_at = x->at;
     // Each level multiplies the mesh by 8: four levels of the default mesh would be ten million hexes.
-    if (m.validation_levels < 0 || m.validation_levels > 3)
-      fail(x->at, "mesh.validation_levels is " + std::to_string(m.validation_levels) +
+    if (n < 0 || n > 3)
+      fail(x->at, "mesh.validation_levels is " + std::to_string(n) +
                       " but must be 0 (none), 1, 2 or 3; each level refines the mesh 8-way and solves again");
+    m.validation_levels = static_cast<int>(n);
   }
   if (auto x = map.find("refine_at_bite")) {
     m.refine_at_bite = to_bool(*x);
@@ -326,13 +329,14 @@ MeshSettings parse_mesh(const Value& v) {
                       fmt(kMinRefineRadiusMm) + " to " + fmt(kMaxRefineRadiusMm) + " mm; the default is 8");
   }
   if (auto x = map.find("refine_levels")) {
-    m.refine_levels = to_int(*x);
+    const long long n = to_whole(*x);
     if (!m.refine_at_bite)
       fail(x->at, "mesh.refine_levels needs refine_at_bite: true in mesh; add it or remove this key");
-    if (m.refine_levels < 1 || m.refine_levels > kMaxRefineLevels)
-      fail(x->at, "mesh.refine_levels is " + std::to_string(m.refine_levels) + " but must be from 1 to " +
+    if (n < 1 || n > kMaxRefineLevels)
+      fail(x->at, "mesh.refine_levels is " + std::to_string(n) + " but must be from 1 to " +
                       std::to_string(kMaxRefineLevels) +
                       " (rings of quads around the bite point); the default is 3");
+    m.refine_levels = static_cast<int>(n);
   }
   if (auto x = map.find("fit_volume")) m.fit_volume = to_bool(*x);
   if (auto x = map.find("grid_frame")) {
@@ -594,9 +598,9 @@ SolverSpec parse_solver(const Value& v) {
   SolverSpec s;
   s.where = v.at;
   if (auto x = map.find("degree")) {
-    s.degree = to_int(*x);
-    if (s.degree != 1 && s.degree != 2)
-      fail(x->at, "solver.degree is " + std::to_string(s.degree) + "; use 1 (Q1) or 2 (Q2)");
+    const long long n = to_whole(*x);
+    if (n != 1 && n != 2) fail(x->at, "solver.degree is " + std::to_string(n) + "; use 1 (Q1) or 2 (Q2)");
+    s.degree = static_cast<int>(n);
   }
   if (auto x = map.find("linear_solver"))
     s.linear_solver = to_choice<LinearSolverChoice>(*x, {{"auto", LinearSolverChoice::kAuto},
@@ -609,8 +613,11 @@ SolverSpec parse_solver(const Value& v) {
                       " but a relative tolerance must lie in (0, 1); the default is 1e-10");
   }
   if (auto x = map.find("max_iterations")) {
-    s.max_iterations = to_int(*x);
-    if (s.max_iterations <= 0) fail(x->at, "solver.max_iterations must be positive; the default is 10000");
+    const long long n = to_whole(*x);
+    if (n <= 0 || n > std::numeric_limits<int>::max())
+      fail(x->at, "solver.max_iterations is " + std::to_string(n) + " but must be from 1 to " +
+                      std::to_string(std::numeric_limits<int>::max()) + "; the default is 10000");
+    s.max_iterations = static_cast<int>(n);
   }
   return s;
 }
@@ -712,7 +719,8 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
   const SourceLocation top{ctx.file, 1, 1, ctx.note};
   if (!root_node.IsDefined() || root_node.IsNull())
     fail(top,
-         "the scenario file is empty; it needs at least 'name', 'geometry', 'muscles' and 'supports' "
+         "the scenario file is empty; it needs at least 'name', 'geometry', 'supports' and the muscle "
+         "forces ('muscles' or 'activation_pattern') "
          "(see docs/scenario-format.md)");
   const Value root_value{&ctx, root_node, top, ""};
   if (!root_node.IsMap())
@@ -729,15 +737,16 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
   Scenario s;
   s.path = ctx.file;
   if (auto x = root.find("format_version")) {
-    s.format_version = to_int(*x);
-    if (s.format_version != 1)
+    const long long n = to_whole(*x);
+    if (n != 1)
       fail(x->at,
-           "format_version " + std::to_string(s.format_version) +
+           "format_version " + std::to_string(n) +
                " is not known to this hexbite, which reads format_version 1; update hexbite or the file");
+    s.format_version = 1;
   }
   s.name = to_string(root.require("name", "name: lateral_bite"));
   if (auto x = root.find("description"))
-    s.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x);
+    s.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x, kTextHint);
   s.geometry = parse_geometry(ctx, root.require("geometry", "geometry: {mandible: {variant: dentate}}"));
   s.landmarks = parse_landmarks(ctx, root.find("landmarks"), s.geometry);
   if (auto x = root.find("mesh")) s.mesh = parse_mesh(*x);

@@ -188,7 +188,7 @@ Study load_study(const std::string& path) {
   study.path = path;
   study.name = to_string(map.require("name", "name: atrophy what-if"));
   if (auto x = map.find("description"))
-    study.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x);
+    study.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x, kTextHint);
 
   const Value& base = map.require("base", "base: ../lateral_bite_hard_nut.yaml (a scenario file)");
   fs::path base_path(to_string(base));

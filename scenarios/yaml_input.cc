@@ -59,9 +59,9 @@ std::string describe(const YAML::Node& node) {
   return quote(node.Scalar());
 }
 
-std::string to_string(const Value& v) {
+std::string to_string(const Value& v, const std::string& hint) {
   if (!v.node.IsScalar() || v.node.Scalar().empty())
-    fail(v.at, v.path + " must be text, found " + describe(v.node) + "; write a word such as left_condyle");
+    fail(v.at, v.path + " must be text, found " + describe(v.node) + "; " + hint);
   return v.node.Scalar();
 }
 

@@ -66,7 +66,12 @@ std::string describe(const YAML::Node& node);
 // (quoted text, fractions, lists, numbers beyond +-2^53).
 bool decimal_whole_number(const YAML::Node& node, long long* value);
 
-std::string to_string(const Value& v);       // non-empty text
+// What to write for free text (a description) that came as a list or a mapping.
+inline const std::string kTextHint =
+    "write it as one line of text, in quotes if it holds a colon or starts with [ or {";
+
+// Non-empty text; `hint` says what to write instead of a list, a mapping or nothing.
+std::string to_string(const Value& v, const std::string& hint = "write a word such as left_condyle");
 std::vector<Value> to_list(const Value& v);  // a list (null reads as an empty one)
 
 // A mapping whose keys are checked against the valid ones on construction (unknown and repeated keys are

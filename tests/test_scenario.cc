@@ -428,6 +428,15 @@ TEST(ScenarioErrors, IllTypedFields) {
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 0x1000}\n"), 11,
                   "mesh.target_hexes must be a whole number, found '0x1000'; write it in decimal digits");
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 0o7640}\n"), 11, "write it in decimal digits");
+  // Whole numbers beyond an int are out of range, not "not whole" (1e10 was "must be a whole number").
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 1e10}\n"), 11,
+                  "mesh.target_hexes is 10000000000 but must be from 8 to 5000000");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {validation_levels: 2147483648}\n"), 11,
+                  "mesh.validation_levels is 2147483648 but must be 0 (none), 1, 2 or 3");
+  EXPECT_ERROR_AT(error_of(kValid + "solver: {max_iterations: 1e12}\n"), 11,
+                  "solver.max_iterations is 1000000000000 but must be from 1 to 2147483647");
+  EXPECT_ERROR_AT(error_of(kValid + "description: [a, b]\n"), 11,
+                  "description must be text, found a list; write it as one line of text");
   EXPECT_ERROR_AT(error_of(kValid + "outputs: {vtu: maybe}\n"), 11, "outputs.vtu must be true or false");
   EXPECT_ERROR_AT(error_of(kValid + "probes: {name: x}\n"), 11, "probes must be a list");
   EXPECT_ERROR_AT(error_of(replace(kValid, "at: right_condyle_tmj_point", "at: [1, 2]")), 9,
@@ -699,7 +708,10 @@ TEST(ScenarioErrors, TabInTheIndentationIsNamed) {
 
 TEST(ScenarioErrors, YamlSyntaxAndEmptyFiles) {
   EXPECT_ERROR_AT(error_of("name: t\ngeometry: {mandible: [1, 2\n"), 2, "YAML syntax error");
-  EXPECT_ERROR_AT(error_of(""), 1, "the scenario file is empty");
+  EXPECT_ERROR_AT(
+      error_of(""), 1,
+      "the scenario file is empty; it needs at least 'name', 'geometry', 'supports' and the muscle "
+      "forces ('muscles' or 'activation_pattern')");
   EXPECT_THROW(load_scenario("/nonexistent/scenario.yaml"), InputError);
 }
 
