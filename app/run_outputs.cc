@@ -13,6 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/number_format.h"
+#include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
 #include "postprocess/quality_json.h"
 #include "solver/mpi_session.h"
@@ -328,7 +329,7 @@ json results_json(const RunResult& r, double seconds_output) {
                {"nodes", coarse.mesh.vertices.size()},
                {"dofs", coarse.solution.dofs},
                {"degree", s.solver.degree},
-               {"quality", quality_to_json(coarse.quality)},
+               {"quality", quality_to_json(coarse.quality, hex_mesh_volume(coarse.mesh))},
                {"fidelity", fidelity_to_json(r.fidelity)}};
   if (!r.mesh_core.empty()) j["mesh"]["core"] = r.mesh_core;
   // The model as solved, so that a report (hexbite report) can say what was simulated without the scenario.
@@ -527,9 +528,16 @@ void RunOutputs::commit(const std::string& results_text) {
 std::string summary_table(const RunResult& r) {
   std::ostringstream out;
   char line[256];
+  // The label column fits the longest reaction row ("reaction right_first_molar (N)" pushed its figures two
+  // columns right of the others').
+  std::size_t width = 28;
+  for (const Support& support : r.scenario.supports)
+    width = std::max(width, std::string("reaction  (N)").size() + support.name.size() + 2);
+  const auto label_cell = [&](const std::string& label) {
+    out << label << std::string(width > label.size() ? width - label.size() : 1, ' ');
+  };
   const auto row = [&](const char* label, const char* format, auto value) {
-    std::snprintf(line, sizeof line, "%-28s", label);
-    out << line;
+    label_cell(label);
     for (const LevelResult& l : r.levels) {
       std::snprintf(line, sizeof line, format, value(l));
       out << line;
@@ -537,14 +545,12 @@ std::string summary_table(const RunResult& r) {
     out << '\n';
   };
   // Figures in fixed point, but never a small one shown as zero (format_table_number).
-  const auto figure_row = [&](const char* label, int decimals, auto value) {
-    std::snprintf(line, sizeof line, "%-28s", label);
-    out << line;
+  const auto figure_row = [&](const std::string& label, int decimals, auto value) {
+    label_cell(label);
     for (const LevelResult& l : r.levels) out << format_table_number(value(l), decimals, 14);
     out << '\n';
   };
-  std::snprintf(line, sizeof line, "%-28s", "level");
-  out << line;
+  label_cell("level");
   for (const LevelResult& l : r.levels) {
     std::snprintf(line, sizeof line, "%14d", l.level);
     out << line;
@@ -556,7 +562,7 @@ std::string summary_table(const RunResult& r) {
     figure_row("bite force (N)", 2, [](const LevelResult& l) { return l.solution.bite_force; });
   for (std::size_t i = 0; i < r.scenario.supports.size(); ++i) {
     const std::string label = "reaction " + r.scenario.supports[i].name + " (N)";
-    figure_row(label.c_str(), 2, [i](const LevelResult& l) { return l.solution.reactions[i].magnitude; });
+    figure_row(label, 2, [i](const LevelResult& l) { return l.solution.reactions[i].magnitude; });
   }
   // A released contact's row reads 0; say why, and at which levels.
   for (std::size_t i = 0; i < r.scenario.supports.size(); ++i) {

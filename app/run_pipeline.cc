@@ -33,6 +33,7 @@
 #include "mesher/union_find.h"
 #include "mesher/units.h"
 #include "mesher/vec3.h"
+#include "postprocess/report_format.h"
 #include "solver/mpi_session.h"
 
 namespace hexbite {
@@ -642,11 +643,12 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
       n = std::snprintf(text, sizeof text, "body %d of %d (%ld hexes, around (%.1f, %.1f, %.1f) mm): ", b + 1,
                         bodies.count, bodies.hexes[b], bodies.centre[b][0], bodies.centre[b][1],
                         bodies.centre[b][2]);
-    std::snprintf(text + n, sizeof text - n,
-                  "the supports hold the bone only weakly against a rotation about the axis through (%.1f, "
-                  "%.1f, %.1f) mm along (%.2f, %.2f, %.2f): only the extent of their patches resists it",
-                  m.axis_point[0], m.axis_point[1], m.axis_point[2], m.direction[0], m.direction[1],
-                  m.direction[2]);
+    // The points as the report writes them (format_point): a small component is not "-0.00".
+    std::snprintf(text + n, sizeof text - n, "%s",
+                  ("the supports hold the bone only weakly against a rotation about the axis through " +
+                   format_point(m.axis_point) + " mm along " + format_point(m.direction, 2) +
+                   ": only the extent of their patches resists it")
+                      .c_str());
     char hold[256];
     std::snprintf(hold, sizeof hold,
                   " (hold %.2g, below %.2g; the shipped scenarios 0.33 to 1.28), so the displacements and "

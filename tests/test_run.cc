@@ -4,6 +4,8 @@
 // the literature ranges of DESIGN.md section 4.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -21,6 +23,7 @@
 #include "common/system_memory.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_mesh_io.h"
+#include "postprocess/report_format.h"
 #include "tests/test_util.h"
 
 namespace hexbite {
@@ -65,7 +68,8 @@ void expect_contract(const json& r, std::size_t levels) {
     EXPECT_TRUE(r.contains(key)) << key;
   for (const char* key : {"hexes", "nodes", "dofs", "degree", "quality", "fidelity"})
     EXPECT_TRUE(r["mesh"].contains(key)) << "mesh." << key;
-  for (const char* key : {"scaled_jacobian", "condition", "oddy", "inverted"})
+  // mesh.quality is the object of `hexbite quality --json` (running.md); volume_mm3 was missing.
+  for (const char* key : {"scaled_jacobian", "condition", "oddy", "inverted", "volume_mm3"})
     EXPECT_TRUE(r["mesh"]["quality"].contains(key)) << "mesh.quality." << key;
   for (const char* key : {"hausdorff_mm", "volume_difference"})
     EXPECT_TRUE(r["mesh"]["fidelity"].contains(key)) << "mesh.fidelity." << key;
@@ -1061,6 +1065,27 @@ TEST(RunSummaryTable, RelativeChangeOfTheLastLevelShowsSmallChanges) {
       << table;
 }
 
+// A support name longer than the label column ("reaction right_first_molar (N)", the shipped clench's)
+// pushed that row's figures two columns right of every other row's: the column now fits the longest label.
+TEST(RunSummaryTable, LongSupportNamesKeepTheColumns) {
+  RunResult r;
+  r.levels.resize(2);
+  r.levels[1].level = 1;
+  for (const char* name : {"nut", "a_support_with_a_rather_long_name"}) {
+    r.scenario.supports.emplace_back();
+    r.scenario.supports.back().name = name;
+  }
+  for (LevelResult& l : r.levels) l.solution.reactions.resize(2);
+  const std::string table = summary_table(r);
+  std::istringstream lines(table);
+  std::string line;
+  std::set<std::size_t> ends;
+  while (std::getline(lines, line))
+    if (line.rfind("relative change", 0) != 0 && line.rfind("  (", 0) != 0) ends.insert(line.size());
+  EXPECT_EQ(ends.size(), 1u) << table;  // every row of figures ends in the same column
+  EXPECT_NE(table.find("reaction a_support_with_a_rather_long_name (N)  "), std::string::npos) << table;
+}
+
 // A node on two fixed supports gives its whole reaction to the first one: a bite patch reaching a condyle's
 // patch reported the condyle's reaction as the bite force (342 N, the condyle 0 N) with exit 0.
 TEST(RunScenario, FixedSupportsSharingNodesAreRefused) {
@@ -1130,6 +1155,10 @@ TEST(RunScenario, WeakSupportsAreWarnedAboutAndReported) {
   EXPECT_LT(hold["hold"].get<double>(), 0.01);
   EXPECT_EQ(hold["weakest_motion"], "rotation");
   EXPECT_GT(std::abs(hold["direction"][1].get<double>()), 0.9) << hold.dump();
+  // The axis as the report writes it: a component of -9.3e-4 read "-0.00" here and "-9.31e-04" there.
+  const Vec3 along{hold["direction"][0].get<double>(), hold["direction"][1].get<double>(),
+                   hold["direction"][2].get<double>()};
+  EXPECT_NE(r.err.find(" mm along " + format_point(along, 2) + ": "), std::string::npos) << r.err;
 }
 
 // With a contact released the bone may hang on the supports left: the weak-support check is made again for
