@@ -11,6 +11,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -291,6 +292,13 @@ void require_complete_legacy_sections(const std::string& path) {
       if (!(integers ? number(value, integer) : number(value, real)))
         throw InputError(quoted(path) + " line " + std::to_string(line) + ": '" + value + "' in its " +
                          section + " section is not " + (integers ? "an integer" : "a number") +
+                         "; fix the file or export it again");
+      // VTK reads a 32-bit type's value into an int, and one beyond it crashed the reader.
+      if (integers && legacy_type_size(type) == 4 &&
+          (integer < std::numeric_limits<std::int32_t>::min() ||
+           integer > std::numeric_limits<std::int32_t>::max()))
+        throw InputError(quoted(path) + " line " + std::to_string(line) + ": '" + value + "' in its " +
+                         section + " section is beyond the 32-bit integers of its type " + type +
                          "; fix the file or export it again");
     }
     return true;

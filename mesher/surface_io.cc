@@ -569,6 +569,13 @@ TriSurface read_ply(const std::string& path) {
       if (tok.size() != 3 || !parse_integer(tok[2], e.count) || e.count < 0 || e.count > INT32_MAX)
         throw header_error("expected 'element NAME COUNT'");
       e.name = std::string(tok[1]);
+      // A second vertex or face element (the first one empty, say) was read with the first one's property
+      // places and crashed.
+      if ((e.name == "vertex" || e.name == "face") &&
+          std::any_of(elements.begin(), elements.end(),
+                      [&](const PlyElement& x) { return x.name == e.name; }))
+        throw header_error("a second 'element " + e.name +
+                           "': a surface has one vertex and one face element");
       elements.push_back(e);
     } else if (tok[0] == "property") {
       if (elements.empty()) throw header_error("a property before any element");

@@ -245,6 +245,11 @@ TEST(QuadSurfaceIo, CutOffLegacyVtkIsRefusedNotACrash) {
       {"none.vtk", head + "POLYGONS 1 5\n", "the file ends inside its POLYGONS section"},
       {"word.vtk", head + "POLYGONS 1 5\n4 0 1 2 x\n",
        "line 8: 'x' in its POLYGONS section is not an integer"},
+      // Beyond an int (VTK reads one into an int): a segmentation fault.
+      {"huge.vtk", head + "POLYGONS 1 5\n4 0 1 2 2147483648\n",
+       "line 8: '2147483648' in its POLYGONS section is beyond the 32-bit integers of its type int"},
+      {"count.vtk", head + "POLYGONS 1 5\n4294967297 0 1 2 3\n",
+       "'4294967297' in its POLYGONS section is beyond"},
       {"lines.vtk", head + "LINES 1 5\n4 0 1\n", "the file ends inside its LINES section"},
       {"points.vtk", head.substr(0, head.size() - 7) + "\nPOLYGONS 1 5\n4 0 1 2 3\n",
        "'POLYGONS' in its POINTS section is not a number"},

@@ -287,6 +287,18 @@ TEST(SurfaceIo, PlyWithFacesBeforeVertices) {
                      {"face 5 (0-based) refers to vertex 8", "the file has 8 vertices"});
 }
 
+// A second vertex element after an empty one (a damaged header) crashed the reader (exit 139): the first
+// one's property places were used for the second.
+TEST(SurfaceIoErrors, PlyWithTwoVertexElements) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/two.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nelement vertex 3\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+             "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  expect_input_error([&] { read_surface(dir + "/two.ply"); },
+                     {"two.ply' line 4: a second 'element vertex'", "fix the PLY header"});
+}
+
 TEST(SurfaceIo, BigEndianPly) {
   std::string bytes =
       "ply\nformat binary_big_endian 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
