@@ -18,6 +18,10 @@
 #include <iterator>
 #include <limits>
 #include <new>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/error.h"
 
@@ -73,6 +77,26 @@ bool cell_data_without_point_data(vtkXMLDataElement* e, std::string* unnamed, in
   return found;
 }
 
+// Throws when a <DataArray> below e announces fewer than 1 or more than 1,000 components: VTK's reader
+// resized its arrays by the negative count and failed with the C++ library's "vector::_M_default_append".
+void check_component_counts(vtkXMLDataElement* e, const std::string& file) {
+  for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
+    vtkXMLDataElement* child = e->GetNestedElement(i);
+    if (child->GetName() != nullptr && std::strcmp(child->GetName(), "DataArray") == 0)
+      if (const char* value = child->GetAttribute("NumberOfComponents")) {
+        errno = 0;
+        const long long n = std::strtoll(value, nullptr, 10);
+        if (n < 1 || n > 1000 || errno == ERANGE) {
+          const char* name = child->GetAttribute("Name");
+          throw InputError("cannot read '" + file + "': its data array '" + (name ? name : "(unnamed)") +
+                           "' announces NumberOfComponents=\"" + value +
+                           "\", not from 1 to 1000; the file is damaged");
+        }
+      }
+    check_component_counts(child, file);
+  }
+}
+
 // Throws when a <Piece> below e announces more points or cells than hexbite reads (2^31 - 1 of each): VTK
 // allocates what a piece announces before it reads the data, so a damaged count (10^15 points) ended in
 // std::bad_alloc and a "does not fit in memory" failure instead of naming the damage.
@@ -95,7 +119,131 @@ void check_piece_counts(vtkXMLDataElement* e, const std::string& file) {
         throw InputError("cannot read '" + file + "': its <Piece> announces " + count + "=\"" + value +
                          "\", more than the 2^31 - 1 that hexbite reads; the file is damaged (check the "
                          "counts in its <Piece> element) or too large for hexbite");
+      if (n < 0)  // a negative count crashed VTK's reader of compressed data (exit 139)
+        throw InputError(
+            "cannot read '" + file + "': its <Piece> announces " + count + "=\"" + value +
+            "\", a negative count; the file is damaged (check the counts in its <Piece> element)");
     }
+    check_component_counts(child, file);
+  }
+}
+
+// A data array in the appended section: its offset, name, and the bytes its data must have uncompressed
+// (-1 when the piece's counts do not say, as for a cell connectivity).
+struct AppendedArray {
+  long long offset = -1;
+  std::string name;
+  long long bytes = -1;
+};
+
+long long attribute_count(vtkXMLDataElement* e, const char* key) {
+  const char* value = e != nullptr ? e->GetAttribute(key) : nullptr;
+  return value != nullptr ? std::strtoll(value, nullptr, 10) : -1;
+}
+
+long long type_size(const char* type) {
+  if (type == nullptr) return -1;
+  const std::string t(type);
+  if (t == "Float64" || t == "Int64" || t == "UInt64") return 8;
+  if (t == "Float32" || t == "Int32" || t == "UInt32") return 4;
+  if (t == "Int16" || t == "UInt16") return 2;
+  if (t == "Int8" || t == "UInt8") return 1;
+  return -1;
+}
+
+// The arrays below e stored in the appended section; `piece` and `section` are e's <Piece> and the element
+// the arrays sit in (Points, PointData, CellData, Cells).
+void appended_arrays(vtkXMLDataElement* e, vtkXMLDataElement* piece, const std::string& section,
+                     std::vector<AppendedArray>& out) {
+  for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
+    vtkXMLDataElement* child = e->GetNestedElement(i);
+    const std::string name = child->GetName() != nullptr ? child->GetName() : "";
+    const char* format = child->GetAttribute("format");
+    if (name == "DataArray" && format != nullptr && std::strcmp(format, "appended") == 0) {
+      AppendedArray a;
+      errno = 0;
+      a.offset = attribute_count(child, "offset");
+      if (errno == ERANGE) a.offset = -1;
+      a.name = child->GetAttribute("Name") ? child->GetAttribute("Name") : "(unnamed)";
+      const long long points = attribute_count(piece, "NumberOfPoints"),
+                      cells = attribute_count(piece, "NumberOfCells");
+      long long tuples = -1;
+      if (section == "Points" || section == "PointData") tuples = points;
+      if (section == "CellData" || (section == "Cells" && a.name != "connectivity")) tuples = cells;
+      const long long components = std::max(1LL, attribute_count(child, "NumberOfComponents"));
+      const long long size = type_size(child->GetAttribute("type"));
+      if (tuples >= 0 && size > 0) a.bytes = tuples * components * size;
+      out.push_back(a);
+      continue;
+    }
+    appended_arrays(child, name == "Piece" ? child : piece,
+                    name == "Piece" ? ""
+                    : name.empty()  ? section
+                                    : name,
+                    out);
+  }
+}
+
+// Throws when a data array's block in the raw appended section does not lie within the file: VTK 9.1 reads a
+// compressed array's block header at the array's offset and follows its sizes unchecked, so a wrong offset
+// (one damaged digit) ended in a segmentation fault. Each block is a header (uncompressed: its byte count;
+// compressed: the number of blocks, their size, the last one's size and each block's compressed size, in
+// the file's header_type) followed by the bytes it announces. Hand-written: VTK has no check of its own.
+void check_appended_blocks(vtkXMLDataElement* root, const std::string& file) {
+  std::vector<AppendedArray> arrays;
+  appended_arrays(root, nullptr, "", arrays);
+  if (arrays.empty()) return;
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t tag = bytes.find("<AppendedData");
+  if (tag == std::string::npos) return;  // VTK says so
+  const std::size_t tag_end = bytes.find('>', tag);
+  if (tag_end == std::string::npos || bytes.substr(tag, tag_end - tag).find("\"raw\"") == std::string::npos)
+    return;  // base64: VTK decodes and checks it
+  const std::size_t start = bytes.find('_', tag_end);
+  if (start == std::string::npos) return;
+  const std::size_t data = start + 1, end = bytes.size();
+  const char* header_type = root->GetAttribute("header_type");
+  const std::size_t word = header_type != nullptr && std::strcmp(header_type, "UInt64") == 0 ? 8 : 4;
+  const bool compressed = root->GetAttribute("compressor") != nullptr;
+  const auto read_word = [&](std::size_t at) {  // little-endian, as hexbite's and most writers' files are
+    unsigned long long v = 0;
+    for (std::size_t k = 0; k < word; ++k)
+      v |= static_cast<unsigned long long>(static_cast<unsigned char>(bytes[at + k])) << (8 * k);
+    return v;
+  };
+  const char* byte_order = root->GetAttribute("byte_order");
+  if (byte_order != nullptr && std::strcmp(byte_order, "LittleEndian") != 0) return;
+  for (const auto& [offset, name, expected] : arrays) {
+    const auto damaged = [&](const std::string& what) {
+      return InputError("cannot read '" + file + "': the data of its array '" + name + "' " + what +
+                        "; the file is damaged (an offset or a size in it is wrong): export it again");
+    };
+    if (offset < 0 || data + static_cast<unsigned long long>(offset) + word > end)
+      throw damaged("would start at offset " + std::to_string(offset) + ", beyond the appended data's " +
+                    std::to_string(end - data) + " bytes");
+    std::size_t at = data + static_cast<std::size_t>(offset);
+    unsigned long long payload = 0, size = 0;  // bytes in the file, and uncompressed
+    if (!compressed) {
+      payload = size = read_word(at);
+      at += word;
+    } else {
+      if (at + 3 * word > end) throw damaged("has its block header cut off");
+      const unsigned long long blocks = read_word(at);
+      if (blocks > (end - at) / word)
+        throw damaged("announces " + std::to_string(blocks) + " blocks, more than the file holds");
+      if (at + (3 + blocks) * word > end) throw damaged("has its block header cut off");
+      for (unsigned long long b = 0; b < blocks; ++b) payload += read_word(at + (3 + b) * word);
+      const unsigned long long block = read_word(at + word), last = read_word(at + 2 * word);
+      size = blocks == 0 ? 0 : (blocks - 1) * block + (last != 0 ? last : block);
+      at += (3 + blocks) * word;
+    }
+    if (expected >= 0 && size != static_cast<unsigned long long>(expected))
+      throw damaged("holds " + std::to_string(size) + " bytes where its piece's counts give " +
+                    std::to_string(expected));
+    if (payload > end - at)
+      throw damaged("announces " + std::to_string(payload) + " bytes where " + std::to_string(end - at) +
+                    " remain in the file");
   }
 }
 
@@ -192,9 +340,18 @@ void update_xml_reader(vtkXMLReader* reader, const std::string& file) {
                        " has no Name attribute; the file is damaged, or its writer left the name out");
     if (root != nullptr) {
       check_piece_counts(root, file);
+      // A file read from a string (with_point_data above) has its data in that string, not in the file;
+      // its offsets are the file's own, so the file's bytes are checked all the same.
+      check_appended_blocks(root, file);
       disable_string_arrays(root, reader);
     }
     reader->Update();
+  } catch (const std::length_error&) {
+    // Sizes read from damaged data (bytes inserted into an appended section) that a vector cannot take:
+    // "vector::_M_fill_insert", exit 1, and no file named.
+    throw InputError(
+        "cannot read '" + file +
+        "': its data sections announce sizes that cannot be; the file is damaged (export it again)");
   } catch (const std::bad_alloc&) {
     // VTK allocates what the header announces before it reads the data.
     throw RunError("cannot read '" + file +

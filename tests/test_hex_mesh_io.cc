@@ -296,6 +296,56 @@ TEST(HexMeshIo, ImpossiblePointCountNamesTheFile) {
       << msg;
 }
 
+// The fuzzer's damaged compressed VTUs: a negative count, one wrong array offset (both a segmentation
+// fault in VTK's reader, exit 139), a negative component count and bytes inserted into the appended data
+// (both "vector::..." from the C++ library, exit 1). Each is now an InputError naming the file.
+TEST(HexMeshIo, DamagedAppendedDataIsRefusedNotACrash) {
+  const std::string dir = temp_dir();
+  write_vtu(dir + "/m.vtu", make_block_mesh(2, 2, 2));
+  const std::string good = test::read_file(dir + "/m.vtu");
+  const auto damaged = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string text = good;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    write_file(dir + "/" + name, text);
+    return test::message_of<InputError>([&] { read_vtu(dir + "/" + name); });
+  };
+  EXPECT_NE(damaged("np.vtu", "NumberOfPoints=\"27\"", "NumberOfPoints=\"-1\"")
+                .find("np.vtu': its <Piece> announces NumberOfPoints=\"-1\", a negative count"),
+            std::string::npos);
+  EXPECT_NE(damaged("comp.vtu", "NumberOfComponents=\"3\"", "NumberOfComponents=\"-1\"")
+                .find("comp.vtu': its data array 'Points' announces NumberOfComponents=\"-1\""),
+            std::string::npos);
+  // The second array's offset (the first is at 0) moved to 1.
+  const std::size_t second = good.find("offset=\"", good.find("offset=\"0\"") + 10);
+  const std::string offset = good.substr(second, good.find('"', second + 8) + 1 - second);
+  EXPECT_NE(damaged("off.vtu", offset, "offset=\"1\"").find("off.vtu': the data of its array '"),
+            std::string::npos);
+  const std::size_t data = good.find('_', good.find("<AppendedData")) + 1;
+  EXPECT_NE(damaged("ins.vtu", good.substr(data, 8), "ABCDEFGHIJ" + good.substr(data, 8))
+                .find("ins.vtu': the data of its array '"),
+            std::string::npos);
+  // A file VTK's own writer makes (raw appended data, uncompressed, 32-bit headers) still reads.
+  const HexMesh cube = make_block_mesh(1, 1, 1);
+  vtkNew<vtkPoints> points;
+  for (const Vec3& p : cube.vertices) points->InsertNextPoint(p[0], p[1], p[2]);
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  vtkIdType hex[8];
+  for (int k = 0; k < 8; ++k) hex[k] = cube.hexes[0][k];
+  grid->InsertNextCell(VTK_HEXAHEDRON, 8, hex);
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetFileName((dir + "/vtk.vtu").c_str());
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToNone();
+  writer->SetHeaderTypeToUInt32();
+  ASSERT_EQ(writer->Write(), 1);
+  EXPECT_EQ(read_vtu(dir + "/vtk.vtu").hexes.size(), 1u);
+}
+
 // Parses the *NODE, *ELEMENT and set blocks of an .inp file written by write_inp.
 struct ParsedInp {
   std::vector<Vec3> nodes;
