@@ -38,6 +38,7 @@
 #include "common/number_format.h"
 #include "common/paths.h"
 #include "mesher/dicom_series.h"
+#include "mesher/units.h"
 #include "mesher/vtk_messages.h"
 
 namespace hexbite {
@@ -166,6 +167,22 @@ void check_volume(const VoxelVolume& volume) {
   const Vec3 h = volume.spacing_xyz();
   for (double s : h)
     if (!(s > 0) || !std::isfinite(s)) throw InputError("the volume's voxel spacing must be positive");
+  // An origin or spacing of 1e40 gave a surface with infinite coordinates, written with exit 0; the surface
+  // readers refuse coordinates beyond kMaxCoordinateMm, and so does the volume.
+  for (int a = 0; a < 3; ++a) {
+    const double first = volume.origin[a], last = first + (d[a] - 1) * h[a];
+    if (!std::isfinite(first) || !std::isfinite(last) || std::abs(first) > kMaxCoordinateMm ||
+        std::abs(last) > kMaxCoordinateMm) {
+      char text[256];
+      std::snprintf(
+          text, sizeof text,
+          "the volume's voxels reach %g mm along %c (origin %g mm, spacing %g mm, %d voxels), beyond "
+          "the %g mm hexbite reads: its origin or spacing is damaged or in other units",
+          std::isfinite(first) && std::abs(first) > std::abs(last) ? first : last, "xyz"[a], first, h[a],
+          d[a], kMaxCoordinateMm);
+      throw InputError(text);
+    }
+  }
 }
 
 // Reverses the voxel order along `axis` (used for NIfTI orientations that point an axis backwards).

@@ -484,6 +484,22 @@ TEST(CtVolume, SurfaceFromVolumeMatchesTheGeneratorAndRejectsHighThresholds) {
   EXPECT_EQ(r.genus, 0);
 }
 
+// A damaged origin or spacing (Offset = 1e40) gave a surface of infinite coordinates with exit 0.
+TEST(CtVolume, VoxelsBeyondTheCoordinateLimitAreRefused) {
+  VoxelVolume far = generated(MandibleVariant::kAtrophic).ct;
+  far.origin[0] = 1e40;
+  EXPECT_NE(test::message_of<InputError>([&] {
+              surface_from_volume(far, 500.0);
+            }).find("the volume's voxels reach 1e+40 mm along x (origin 1e+40 mm"),
+            std::string::npos);
+  VoxelVolume wide = generated(MandibleVariant::kAtrophic).ct;
+  wide.spacing = 1e300;
+  EXPECT_NE(test::message_of<InputError>([&] {
+              surface_from_volume(wide, 500.0);
+            }).find("its origin or spacing is damaged or in other units"),
+            std::string::npos);
+}
+
 // A small volume that is not symmetric along any axis: value i + 10 j + 100 k.
 VoxelVolume ramp_volume() {
   VoxelVolume v;
