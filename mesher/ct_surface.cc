@@ -19,6 +19,7 @@
 #include <vtkPolyData.h>
 #include <vtkPolyDataConnectivityFilter.h>
 #include <vtkSmartPointer.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
@@ -30,6 +31,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -216,6 +218,74 @@ bool next_header_entry(std::istream& in, int& line, std::string& key, std::istri
     return true;
   }
   return false;
+}
+
+// Throws on what makes MetaIO (inside VTK's reader) fail badly instead of refusing: a header key of 255
+// characters or more overflows its buffer (the process aborted, "buffer overflow detected"), and an NDims
+// below 1 or above 3 made it loop (NDims = -1 hung with a growing memory). Both come from a damaged header
+// (zlib data read as header lines once ElementDataFile is lost).
+void check_metaimage_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  int line = 0;
+  std::string key;
+  std::istringstream values;
+  while (next_header_entry(in, line, key, values)) {
+    if (key.size() >= 255)
+      throw InputError("volume '" + path + "' line " + std::to_string(line) + ": a header key of " +
+                       std::to_string(key.size()) +
+                       " characters (MetaImage keys are short words such as DimSize): the header is damaged; "
+                       "export the volume again");
+    if (key == "NDims") {
+      long long n = 0;
+      if (!(values >> n) || n < 1 || n > 3)
+        throw InputError("volume '" + path + "' line " + std::to_string(line) + ": NDims =" + values.str() +
+                         ", but a CT volume has 3 dimensions (NDims = 3): the header is damaged");
+    }
+    if (key == "ElementDataFile") return;
+  }
+}
+
+// Throws on the NIfTI-1 headers that crashed VTK's reader (a segmentation fault) instead of being refused:
+// a data type it has no reader for (FLOAT128 = 1536, or a code no type has, such as 144) and a dimension
+// of size 0 among the first dim[0]. Reads the 348-byte header itself (gzip or plain: zlib's gzread reads
+// both); NIfTI-2 and what is no NIfTI-1 header are left to VTK.
+void check_nifti_header(const std::string& path) {
+  unsigned char h[348] = {};
+  gzFile in = gzopen(path.c_str(), "rb");
+  if (in == nullptr) return;
+  const int got = gzread(in, h, sizeof h);
+  gzclose(in);
+  if (got != static_cast<int>(sizeof h)) return;
+  const auto int32_at = [&](int at, bool swap) {
+    std::uint32_t v = 0;
+    for (int k = 0; k < 4; ++k) v |= static_cast<std::uint32_t>(h[at + (swap ? 3 - k : k)]) << (8 * k);
+    return static_cast<std::int32_t>(v);
+  };
+  bool swap = false;
+  if (int32_at(0, false) != 348) {
+    if (int32_at(0, true) != 348) return;
+    swap = true;
+  }
+  const auto int16_at = [&](int at) {
+    const int lo = h[at + (swap ? 1 : 0)], hi = h[at + (swap ? 0 : 1)];
+    return static_cast<std::int16_t>(static_cast<std::uint16_t>(lo | (hi << 8)));
+  };
+  // The scalar types of the NIfTI standard that VTK reads; RGB (128) and RGBA (2304) get VTK's message
+  // of several components per voxel, 0 VTK's "Unrecognized".
+  static const std::set<int> kTypes = {0, 2, 4, 8, 16, 64, 128, 256, 512, 768, 1024, 1280, 2304};
+  const int type = int16_at(70);
+  if (kTypes.count(type) == 0)
+    throw InputError(
+        "'" + path + "' has NIfTI datatype " + std::to_string(type) +
+        ", not one of the integer or floating-point voxel types hexbite reads (UINT8 2, INT16 4, "
+        "INT32 8, FLOAT32 16, FLOAT64 64, INT8 256, UINT16 512, UINT32 768, INT64 1024, UINT64 "
+        "1280): export the volume with one of them");
+  const int dims = int16_at(40);
+  for (int a = 1; a <= std::min(dims, 7); ++a)
+    if (int16_at(40 + 2 * a) < 1)
+      throw InputError("'" + path + "' has NIfTI dimension " + std::to_string(a) + " of size " +
+                       std::to_string(int16_at(40 + 2 * a)) +
+                       ": the header is damaged; export the volume again");
 }
 
 // VTK's MetaImage reader ignores the grid's direction (TransformMatrix, also spelled Rotation or
@@ -406,6 +476,7 @@ VoxelVolume read_volume(const std::string& path, VolumeInfo* info, const std::st
   if (fmt.format == VolumeFormat::kMetaImage) {
     auto reader = vtkSmartPointer<vtkMetaImageReader>::New();
     errors.watch(reader);
+    check_metaimage_header(path);
     if (!reader->CanReadFile(path.c_str()))
       throw InputError("'" + path + "' is not a readable MetaImage file (header missing or malformed)" +
                        metaio.reason());
@@ -426,6 +497,7 @@ VoxelVolume read_volume(const std::string& path, VolumeInfo* info, const std::st
   } else {
     auto reader = vtkSmartPointer<vtkNIFTIImageReader>::New();
     errors.watch(reader);
+    check_nifti_header(path);
     if (!reader->CanReadFile(path.c_str()))
       throw InputError("'" + path + "' is not a readable NIfTI file (header missing or malformed)");
     reader->SetFileName(path.c_str());

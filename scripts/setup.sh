@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git clang-format
   libdeal.ii-dev libopenblas0-pthread
-  libeigen3-dev libcgal-dev libvtk9-dev libgdcm-dev
+  libeigen3-dev libcgal-dev libvtk9-dev libgdcm-dev zlib1g-dev
   liblemon-dev libboost-graph-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -1,6 +1,10 @@
 // The built-in CT-like mandible, its landmark files and surface extraction from CT volumes.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
+#include <cstring>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -498,6 +502,56 @@ TEST(CtVolume, VoxelsBeyondTheCoordinateLimitAreRefused) {
               surface_from_volume(wide, 500.0);
             }).find("its origin or spacing is damaged or in other units"),
             std::string::npos);
+}
+
+// Damaged headers that crashed VTK's readers (found by mutation fuzzing): a MetaImage key of 255 characters
+// (MetaIO's buffer overflow, exit 134), NDims = -1 (a hang), a NIfTI datatype VTK has no reader for (1536,
+// FLOAT128, and 144) and a NIfTI dimension of size 0 (segmentation faults). Each is refused, naming the file.
+TEST(CtVolume, DamagedHeadersAreRefusedNotACrash) {
+  const std::string dir = test::temp_dir();
+  const std::string tail = "ElementType = MET_UCHAR\nElementDataFile = LOCAL\nABCDEFGH";
+  test::write_file(dir + "/key.mha", "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\n" +
+                                         std::string(255, 'A') + " = 1\n" + tail);
+  EXPECT_NE(test::message_of<InputError>([&] {
+              read_volume(dir + "/key.mha");
+            }).find("key.mha' line 4: a header key of 255 characters"),
+            std::string::npos);
+  test::write_file(dir + "/ndims.mha", "ObjectType = Image\nNDims = -1\nDimSize = 2 2 2\n" + tail);
+  EXPECT_NE(test::message_of<InputError>([&] {
+              read_volume(dir + "/ndims.mha");
+            }).find("ndims.mha' line 2: NDims = -1, but a CT volume has 3 dimensions"),
+            std::string::npos);
+  // A 2 x 2 x 2 float NIfTI-1 file, then with one header field changed.
+  std::string nifti(352, '\0');
+  const auto put16 = [&](std::size_t at, int v) {
+    nifti[at] = static_cast<char>(v & 0xff);
+    nifti[at + 1] = static_cast<char>((v >> 8) & 0xff);
+  };
+  put16(0, 348 & 0xffff);
+  const int dims[8] = {3, 2, 2, 2, 1, 1, 1, 1};
+  for (int k = 0; k < 8; ++k) put16(40 + 2 * k, dims[k]);
+  put16(70, 16);  // FLOAT32
+  put16(72, 32);
+  const float one = 1.0f, offset = 352.0f;
+  for (int k = 0; k < 4; ++k) std::memcpy(&nifti[80 + 4 * k], &one, 4);  // pixdim[1..3]
+  std::memcpy(&nifti[108], &offset, 4);
+  nifti.replace(344, 4, std::string("n+1\0", 4));
+  nifti += std::string(8 * 4, '\0');
+  test::write_file(dir + "/ok.nii", nifti);
+  EXPECT_NO_THROW(read_volume(dir + "/ok.nii"));
+  for (const auto& [name, at, value, fragment] : std::vector<std::tuple<std::string, int, int, std::string>>{
+           {"f128.nii", 70, 1536, "has NIfTI datatype 1536, not one of"},
+           {"t144.nii", 70, 144, "has NIfTI datatype 144"},
+           {"dim0.nii", 46, 0, "has NIfTI dimension 3 of size 0"}}) {
+    std::string bad = nifti;
+    bad[at] = static_cast<char>(value & 0xff);
+    bad[at + 1] = static_cast<char>((value >> 8) & 0xff);
+    test::write_file(dir + "/" + name, bad);
+    EXPECT_NE(
+        test::message_of<InputError>([&] { read_volume(dir + "/" + name); }).find(name + "' " + fragment),
+        std::string::npos)
+        << name;
+  }
 }
 
 // A small volume that is not symmetric along any axis: value i + 10 j + 100 k.
