@@ -256,6 +256,21 @@ TEST(DicomSeries, AMissingSliceIsNamedByTheFilesAroundTheGap) {
       << e;
 }
 
+// A slice cut off inside its header (after 160 to 300 bytes): GDCM asserted and the process aborted (exit
+// 134, a backtrace from `run`). Now refused, naming the file.
+TEST(DicomSeries, ASliceCutOffInItsHeaderIsNamed) {
+  const std::string dir = written_series();
+  const std::string file = dir + "/ct_0004.dcm";
+  const std::string bytes = test::read_file(file);
+  for (std::size_t keep : {160, 200, 244}) {
+    test::write_file(file, bytes.substr(0, keep));
+    const std::string e = error_of(dir);
+    EXPECT_NE(e.find("file 'ct_0004.dcm' is cut off in its header (" + std::to_string(keep) + " bytes"),
+              std::string::npos)
+        << e;
+  }
+}
+
 // A slice file cut off in its pixel data (an interrupted copy): GDCM reads what is there and fills the rest,
 // which gave a bone with a hole in it and exit 0. Now refused, naming the file.
 TEST(DicomSeries, ASliceCutOffInItsPixelDataIsNamed) {
