@@ -218,6 +218,14 @@ json parse(const std::string& path) {
     throw InputError("'" + path + "':" + std::to_string(line) + ":" + std::to_string(column) +
                      ": not JSON: " + what + "; the run writes results.json whole, so the file was " +
                      "changed or cut since: run the scenario again");
+  } catch (const json::out_of_range& e) {
+    // A number beyond a double (1e999) gave nlohmann's own text and exit 1.
+    std::string what = e.what();
+    if (const std::size_t reason = what.find("] "); reason != std::string::npos)
+      what = what.substr(reason + 2);
+    throw InputError(
+        "'" + path + "': " + what +
+        "; the run writes no such number, so the file was changed since: run the scenario again");
   }
 }
 

@@ -326,6 +326,8 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   wrong_type["bite_force_N"] = "367.0";
   json no_reaction = *results_;  // the report left the support out without a word
   no_reaction["reactions"].erase("floor_rest");
+  std::string overflow = results;
+  overflow.replace(overflow.find("\"bite_force_N\": ") + 16, 1, "1e999,\"x\":");
   const std::string cut = results.substr(0, results.find("\"mesh\""));  // ends inside the object
   const int cut_line = static_cast<int>(count(cut, "\n")) + 1;
   write_file(dir + "/a_file", "x");
@@ -353,6 +355,9 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
        "key 'bite_force_N' is a string, expected a number or null"},
       {{"report", folder_with("no_reaction", no_reaction.dump(1)), "-o", out, "--no-pictures"},
        "key 'reactions.floor_rest' is missing"},
+      // A number beyond a double: nlohmann's own text, exit 1, no file named.
+      {{"report", folder_with("overflow", overflow), "-o", out, "--no-pictures"},
+       "overflow/results.json': number overflow parsing '1e999'; the run writes no such number"},
       {{"report", folder_with("no_vtu", results), "-o", out}, "`outputs: {vtu: false}`"},
       {{"report", folder_with("no_vtu2", results), "-o", out}, "add --no-pictures"},
       {{"report", *run_dir_, "-o", dir + "/r.txt"}, "this command writes .html or .htm"},
