@@ -75,8 +75,10 @@ StudyRow study_row(const StudyVariant& variant, const RunResult& r) {
   row.von_mises_max_MPa = u.von_mises_max;
   row.von_mises_p99_MPa = u.von_mises_p99;
   row.strain_energy_mJ = u.strain_energy;
-  for (const SupportReaction& reaction : u.reactions)
+  for (const SupportReaction& reaction : u.reactions) {
     row.reactions.emplace_back(reaction.name, reaction.magnitude);
+    if (reaction.released) row.released.push_back(reaction.name);
+  }
   return row;
 }
 

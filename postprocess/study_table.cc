@@ -40,6 +40,12 @@ std::vector<std::string> support_names(const json& study) {
   return names;
 }
 
+// True when `support` was a contact released in a row of study.json (its reaction, 0, is not a measure).
+bool released(const json& row, const std::string& support) {
+  return row.contains("released") &&
+         std::find(row["released"].begin(), row["released"].end(), support) != row["released"].end();
+}
+
 // The reaction of `support` in a row of study.json, or null.
 json reaction(const json& row, const std::string& support) {
   return row["reactions"].contains(support) ? row["reactions"][support] : json();
@@ -107,15 +113,19 @@ json study_json(const StudyTable& table) {
                         {"von_mises_max_MPa", row.von_mises_max_MPa},
                         {"von_mises_p99_MPa", row.von_mises_p99_MPa},
                         {"strain_energy_mJ", row.strain_energy_mJ},
-                        {"reactions", reactions}});
+                        {"reactions", reactions},
+                        {"released", row.released}});
   }
   for (json& v : variants) {
     const json& reference = variants.front();
     json change = json::object();
     for (const Figure& f : kFigures) change[f.key] = relative(v[f.key], reference[f.key]);
     json reactions = json::object();
+    // A released contact's 0 is not a measured reaction: no relative change to or from it.
     for (const auto& [name, magnitude] : v["reactions"].items())
-      reactions[name] = relative(magnitude, reaction(reference, name));
+      reactions[name] = released(v, name) || released(reference, name)
+                            ? json()
+                            : relative(magnitude, reaction(reference, name));
     change["reactions"] = reactions;
     v["relative_to_reference"] = change;
   }
@@ -130,14 +140,18 @@ std::string study_csv(const json& study) {
   for (const Figure& f : kFigures) out << ',' << f.key;
   for (const std::string& s : supports) out << ',' << csv_field("reaction_" + s + "_N");
   for (const Figure& f : kFigures) out << ',' << f.key << "_relative";
-  out << '\n';
+  out << ",released_contacts\n";
   for (const json& v : study["variants"]) {
     out << csv_field(v["name"].get<std::string>()) << ',' << csv_field(study_changes(v["set"], false)) << ','
         << v["level"].dump() << ',' << v["hexes"].dump();
     for (const Figure& f : kFigures) out << ',' << csv_number(v[f.key]);
     for (const std::string& s : supports) out << ',' << csv_number(reaction(v, s));
     for (const Figure& f : kFigures) out << ',' << csv_number(v["relative_to_reference"][f.key]);
-    out << '\n';
+    std::string contacts;  // released
+    if (v.contains("released"))
+      for (const json& name : v["released"])
+        contacts += (contacts.empty() ? "" : ";") + name.get<std::string>();
+    out << ',' << csv_field(contacts) << '\n';
   }
   return out.str();
 }
@@ -162,8 +176,12 @@ std::string study_markdown(const json& study) {
         << v["hexes"].dump() << " |";
     for (const Figure& f : kFigures)
       out << ' ' << markdown_figure(v[f.key], reference ? json() : change[f.key], f.decimals) << " |";
-    for (const std::string& s : supports)
-      out << ' ' << markdown_figure(reaction(v, s), reference ? json() : reaction(change, s), 2) << " |";
+    for (const std::string& s : supports) {
+      out << ' '
+          << (released(v, s) ? "0 (released)"
+                             : markdown_figure(reaction(v, s), reference ? json() : reaction(change, s), 2))
+          << " |";
+    }
     out << '\n';
   }
   return out.str();

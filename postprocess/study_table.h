@@ -26,6 +26,7 @@ struct StudyRow {
   double von_mises_p99_MPa = 0;
   double strain_energy_mJ = 0;
   std::vector<std::pair<std::string, double>> reactions;  // support name -> magnitude (N), scenario order
+  std::vector<std::string> released;  // contacts released at that level (their reaction is 0: not a measure)
 };
 
 struct StudyTable {
@@ -40,7 +41,8 @@ struct StudyTable {
 std::string study_changes(const nlohmann::ordered_json& set, bool abbreviate);
 
 // {study, study_file, base, variants: [{name, set, level, hexes, bite_force_N, max_displacement_mm,
-// von_mises_max_MPa, von_mises_p99_MPa, strain_energy_mJ, reactions {support: N}, relative_to_reference
+// von_mises_max_MPa, von_mises_p99_MPa, strain_energy_mJ, reactions {support: N}, released [contacts],
+// relative_to_reference
 // {the same figures and reactions as (variant - reference) / |reference|}}]}; a relative change is null
 // where either figure is missing or the reference's is zero.
 nlohmann::ordered_json study_json(const StudyTable& table);

@@ -219,6 +219,32 @@ std::string soft_setting(const std::string& set_line) {
   return study;
 }
 
+// A contact released in a variant read as a measured 0.00 in study.md, study.csv and study.json, and a
+// variant holding it showed no change against that 0. Now marked, with no relative change to or from it.
+TEST(StudyTable, AReleasedContactIsMarkedNotAMeasuredZero) {
+  StudyTable table;
+  table.study = "contacts";
+  for (const char* name : {"reference", "twosided"}) {
+    StudyRow row;
+    row.name = name;
+    row.set = nlohmann::ordered_json::object();
+    row.bite_force_N = 420.0;
+    row.reactions = {{"molar", 420.0}, {"premolar", std::string(name) == "reference" ? 0.0 : 26.0}};
+    if (std::string(name) == "reference") row.released = {"premolar"};
+    table.rows.push_back(row);
+  }
+  const nlohmann::ordered_json study = study_json(table);
+  EXPECT_EQ(study["variants"][0]["released"], nlohmann::ordered_json({"premolar"}));
+  EXPECT_TRUE(study["variants"][1]["relative_to_reference"]["reactions"]["premolar"].is_null());
+  EXPECT_EQ(study["variants"][1]["relative_to_reference"]["reactions"]["molar"], 0.0);
+  const std::string md = study_markdown(study);
+  EXPECT_NE(md.find("| 0 (released) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 26.00 |"), std::string::npos) << md;  // no per cent against a released 0
+  const std::string csv = study_csv(study);
+  EXPECT_NE(csv.find(",released_contacts\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",premolar\n"), std::string::npos) << csv;
+}
+
 // A line break in a value the study set (description: "a\nb") ended the study.md table row.
 TEST(StudyTable, ALineBreakInAChangeStaysInItsRow) {
   nlohmann::ordered_json variant = {{"name", "a"},
