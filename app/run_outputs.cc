@@ -37,11 +37,17 @@ double norm(const Vec3& v) {
 json level_figures(const Scenario& s, const LevelResult& l) {
   const ElasticitySolution& u = l.solution;
   json reactions = json::object();
-  for (const SupportReaction& r : u.reactions)
+  // Each level selects its patches again on its own boundary (running.md, step 6), so a patch's area
+  // differs between levels; it is given per level (the supports' list gives the coarse level's only).
+  for (std::size_t i = 0; i < u.reactions.size(); ++i) {
+    const SupportReaction& r = u.reactions[i];
     reactions[r.name] = {{"force_N", vec(r.force)},
                          {"magnitude_N", r.magnitude},
                          {"bite", r.is_bite},
-                         {"released", r.released}};
+                         {"released", r.released},
+                         {"patch_area_mm2", l.support_patches[i].area_mm2},
+                         {"facets", l.support_patches[i].faces.size()}};
+  }
   json probes = json::object();
   for (std::size_t i = 0; i < s.probes.size(); ++i) {
     const ProbeValue& p = u.probes[i];

@@ -55,6 +55,9 @@ void expect_level_figures(const json& j, const std::string& where) {
   for (const auto& [name, r] : j["reactions"].items()) {
     EXPECT_EQ(r["force_N"].size(), 3u) << name;
     EXPECT_TRUE(r.contains("magnitude_N")) << name;
+    // Each level's own patch (selected again on its boundary): the coarse one was all the outputs gave.
+    EXPECT_GT(r["patch_area_mm2"].get<double>(), 0.0) << where << " " << name;
+    EXPECT_GT(r["facets"].get<int>(), 0) << where << " " << name;
   }
   EXPECT_LT(j["equilibrium_residual"].get<double>(), 1e-8) << where;
   EXPECT_GT(j["max_displacement_mm"].get<double>(), 0.0) << where;
@@ -83,6 +86,10 @@ void expect_contract(const json& r, std::size_t levels) {
   // The top level holds the coarse level's figures.
   EXPECT_EQ(r["strain_energy_mJ"], r["validation"]["levels"][0]["strain_energy_mJ"]);
   EXPECT_EQ(r["mesh"]["hexes"], r["validation"]["levels"][0]["hexes"]);
+  for (const json& support : r["supports"])
+    EXPECT_EQ(
+        support["patch_area_mm2"],
+        r["validation"]["levels"][0]["reactions"][support["name"].get<std::string>()]["patch_area_mm2"]);
 }
 
 Vec3 vec(const json& j) {
