@@ -177,8 +177,7 @@ struct NearbyPoint {
 struct UnresolvedPart {
   Vec3 location{};    // centroid of the region, mm
   double extent = 0;  // largest distance of the region's surface from the mesh boundary, mm
-  int samples =
-      0;  // the region's surface triangles (a dropped core piece: its grid cells; a shell: its triangles)
+  int samples = 0;    // triangles in the region (a dropped core piece: its grid cells)
   // The solid's thickness under the region (the median inward ray through it), mm; 0 for a whole shell or
   // where no ray crosses the solid.
   double thickness = 0;

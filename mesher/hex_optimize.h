@@ -106,14 +106,13 @@ struct PhaseQuality {
 };
 
 struct OptimizeReport {
-  std::vector<PhaseQuality>
-      phases;                    // "barycentric", "untangled", "final" (each always; callers may add more)
-  int untangle_sweeps = 0;       // over all untangling phases
-  int iterations = 0;            // optimization sweeps (per-node Newton steps over all movable nodes)
-  int rounds = 0;                // untangle + optimize cycles
-  int worst_element_sweeps = 0;  // sweeps of the worst-element pass (both stages)
-  int mean_jacobian_sweeps = 0;  // sweeps of improve_mean_jacobian
-  double energy_before = 0.0;    // sum of squared corner condition numbers, valid hexes only
+  std::vector<PhaseQuality> phases;  // "barycentric", "untangled", "final", each always (callers add)
+  int untangle_sweeps = 0;           // over all untangling phases
+  int iterations = 0;                // optimization sweeps (per-node Newton steps over all movable nodes)
+  int rounds = 0;                    // untangle + optimize cycles
+  int worst_element_sweeps = 0;      // sweeps of the worst-element pass (both stages)
+  int mean_jacobian_sweeps = 0;      // sweeps of improve_mean_jacobian
+  double energy_before = 0.0;        // sum of squared corner condition numbers, valid hexes only
   double energy_after = 0.0;
   int inverted = 0;  // inverted hexes at the end
 };
