@@ -193,6 +193,27 @@ TEST(HexReorderCommand, ReordersAndReports) {
   EXPECT_EQ(j["start"]["hex"], nearest_boundary_hex(mesh, {0, 0, 0}));
 }
 
+// `mesh` with one cell and one point array written to DIR/in.vtu, reordered by `hexbite reorder --method rcm`
+// and read back: the two arrays as they came out (an empty array when missing).
+struct ReorderedArrays {
+  MeshArray cell, point;
+};
+ReorderedArrays reorder_with_arrays(const std::string& dir, const HexMesh& mesh, const MeshArray& cell,
+                                    const MeshArray& point) {
+  write_vtu(dir + "/in.vtu", mesh, {cell}, {point});
+  const auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "-q"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  std::vector<MeshArray> cells, points;
+  read_vtu(dir + "/rcm.vtu", &cells, &points);
+  const auto named = [](const std::vector<MeshArray>& arrays, const std::string& name) {
+    const auto it =
+        std::find_if(arrays.begin(), arrays.end(), [&](const MeshArray& a) { return a.name == name; });
+    EXPECT_NE(it, arrays.end()) << name;
+    return it == arrays.end() ? MeshArray{} : *it;
+  };
+  return {named(cells, cell.name), named(points, point.name)};
+}
+
 // The input's arrays come out in the new order and with their own types: an Int32 material id stays Int32 (it
 // was written back as Float64, which readers that expect integer ids refuse).
 TEST(HexReorderCommand, ArraysKeepTheirValuesAndTypes) {
@@ -202,19 +223,8 @@ TEST(HexReorderCommand, ArraysKeepTheirValuesAndTypes) {
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) material.values.push_back(double(h));
   MeshArray node_id{"node_id", 1, {}, VTK_LONG_LONG};
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) node_id.values.push_back(double(v) + 1e12);
-  write_vtu(dir + "/in.vtu", mesh, {material}, {node_id});
-  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "-q"});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::vector<MeshArray> cells, points;
-  read_vtu(dir + "/rcm.vtu", &cells, &points);
+  const auto [cell, point] = reorder_with_arrays(dir, mesh, material, node_id);
   const ReorderResult expected = reorder_reverse_cuthill_mckee(mesh);
-  const auto named = [](const std::vector<MeshArray>& arrays, const std::string& name) {
-    const auto it =
-        std::find_if(arrays.begin(), arrays.end(), [&](const MeshArray& a) { return a.name == name; });
-    EXPECT_NE(it, arrays.end()) << name;
-    return it == arrays.end() ? MeshArray{} : *it;
-  };
-  const MeshArray cell = named(cells, "material"), point = named(points, "node_id");
   EXPECT_EQ(cell.vtk_type, VTK_INT);
   EXPECT_EQ(point.vtk_type, VTK_LONG_LONG);
   ASSERT_EQ(cell.values.size(), mesh.hexes.size());
@@ -242,18 +252,8 @@ TEST(HexReorderCommand, SixtyFourBitIntegersKeepEveryDigit) {
     ubig.bits64.push_back(~std::uint64_t{0} - v);
     ubig.values.push_back(std::ldexp(1.0, 64));
   }
-  write_vtu(dir + "/in.vtu", mesh, {big}, {ubig});
-  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/rcm.vtu", "--method", "rcm", "-q"});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::vector<MeshArray> cells, points;
-  read_vtu(dir + "/rcm.vtu", &cells, &points);
+  const auto [cell, point] = reorder_with_arrays(dir, mesh, big, ubig);
   const ReorderResult expected = reorder_reverse_cuthill_mckee(mesh);
-  const auto named = [](const std::vector<MeshArray>& arrays, const std::string& name) {
-    const auto it =
-        std::find_if(arrays.begin(), arrays.end(), [&](const MeshArray& a) { return a.name == name; });
-    return it == arrays.end() ? MeshArray{} : *it;
-  };
-  const MeshArray cell = named(cells, "big"), point = named(points, "ubig");
   ASSERT_EQ(cell.bits64.size(), mesh.hexes.size());
   ASSERT_EQ(point.bits64.size(), mesh.vertices.size());
   for (std::size_t i = 0; i < expected.hex_order.size(); ++i)
