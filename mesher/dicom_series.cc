@@ -123,7 +123,10 @@ void require_complete_meta_group(const std::string& file, const std::string& whe
     unsigned long long length = 0;
     std::size_t header = 8;
     if (vr == "OB" || vr == "OW" || vr == "OF" || vr == "SQ" || vr == "UT" || vr == "UN") {
-      if (at + 12 > head.size()) throw cut();
+      if (at + 12 > head.size()) {
+        if (at + 12 > size) throw cut();
+        return;  // as above
+      }
       length = byte(at + 8) | byte(at + 9) << 8 | byte(at + 10) << 16 |
                static_cast<unsigned long long>(byte(at + 11)) << 24;
       header = 12;

@@ -19,7 +19,8 @@ using Point = Kernel::Point_3;
 using Mesh = CGAL::Surface_mesh<Point>;
 
 // The quad pairs that cross when every quad is split along the diagonal from its corner `first` (0 or 1);
-// `ok` is false when CGAL could not build the surface (not a closed oriented manifold).
+// `ok` is false when CGAL's Surface_mesh could not attach a triangle (a non-manifold or inconsistently
+// oriented surface).
 std::vector<std::array<int, 2>> crossings_split_at(const QuadSurface& surface, int first, bool& ok) {
   Mesh mesh;
   std::vector<Mesh::Vertex_index> vertex;
