@@ -551,6 +551,11 @@ TEST(Cli, JsonOutputIsOnlyJsonWithoutQuiet) {
   const std::string jaw = dir + "/jaw.stl", landmarks = dir + "/jaw.yaml";
   auto r = run_hexbite({"generate", "mandible", "-o", jaw, "--landmarks", landmarks, "--voxel", "1.5"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The quad template folds over the coarse (1.5 mm voxel) mandible's ramus (123 pairs of crossing quads,
+  // a failed run): the quad commands get the default one.
+  const std::string fine = dir + "/fine.stl", fine_landmarks = dir + "/fine.yaml";
+  r = run_hexbite({"generate", "mandible", "-o", fine, "--landmarks", fine_landmarks});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::vector<std::vector<std::string>> commands = {
       {"surface", "check", jaw},
       {"surface", "clean", jaw, "-o", dir + "/clean.stl"},
@@ -558,7 +563,7 @@ TEST(Cli, JsonOutputIsOnlyJsonWithoutQuiet) {
       {"quality", dir + "/grid.vtu"},
       {"refine", dir + "/grid.vtu", "--surface", jaw, "-o", dir + "/fine.vtu"},
       {"reorder", dir + "/grid.vtu", "-o", dir + "/ordered.vtu"},
-      {"quad", "from-mandible", jaw, "--landmarks", landmarks, "-o", dir + "/quads.obj"},
+      {"quad", "from-mandible", fine, "--landmarks", fine_landmarks, "-o", dir + "/quads.obj"},
       {"quad", "check", dir + "/quads.obj"},
       {"run", std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml", "-o", dir + "/run",
        "--levels", "0"},
