@@ -477,6 +477,13 @@ TriSurface read_off(const std::string& path) {
     }
     add_fanned(s, corners);
   }
+  // Data after the faces the header announces (a count too small, two files joined) was dropped silently.
+  while (lines.next(tok, true))
+    if (!tok.empty())
+      throw InputError(quoted(path) + " " + lines.where() + ": '" + joined(tok) + "' after the " +
+                       std::to_string(nf) +
+                       " faces the header announces: its counts are wrong or two files were joined; fix the "
+                       "counts or export the surface again");
   return s;
 }
 
@@ -699,6 +706,14 @@ TriSurface read_ply(const std::string& path) {
       }
     }
   }
+  // ASCII data after the elements the header announces (a count too small) was dropped silently.
+  if (!binary)
+    while (body.next(tok, false))
+      if (!tok.empty())
+        throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": '" +
+                         joined(tok) +
+                         "' after the elements the header announces: its counts are wrong or two files were "
+                         "joined; fix the counts or export the surface again");
   std::vector<int> corners;
   for (std::size_t f = 0, begin = 0; f < face_ends.size(); begin = face_ends[f++]) {
     corners.clear();

@@ -287,6 +287,24 @@ TEST(SurfaceIo, PlyWithFacesBeforeVertices) {
                      {"face 5 (0-based) refers to vertex 8", "the file has 8 vertices"});
 }
 
+// Data after the counts the header announces (a fifth face under "4 faces", a garbage line) was dropped
+// without a word; blank lines and OFF comments after the data are fine.
+TEST(SurfaceIoErrors, DataAfterTheAnnouncedCountsIsNamed) {
+  const std::string dir = temp_dir();
+  const std::string off = "OFF\n4 4 0\n0 0 0\n10 0 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  write_file(dir + "/ok.off", off + "\n# end\n");
+  EXPECT_EQ(read_surface(dir + "/ok.off").triangles.size(), 4u);
+  write_file(dir + "/more.off", off + "3 0 1 2\n");
+  expect_input_error([&] { read_surface(dir + "/more.off"); },
+                     {"more.off' line 11: '3 0 1 2' after the 4 faces the header announces"});
+  write_file(dir + "/more.ply",
+             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+             "element face 3\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n10 0 0\n0 10 0\n0 0 "
+             "10\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  expect_input_error([&] { read_surface(dir + "/more.ply"); },
+                     {"more.ply' line 17: '3 1 2 3' after the elements the header announces"});
+}
+
 // A second vertex element after an empty one (a damaged header) crashed the reader (exit 139): the first
 // one's property places were used for the second.
 TEST(SurfaceIoErrors, PlyWithTwoVertexElements) {
