@@ -637,25 +637,23 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
     modes.push_back(weakest_rigid_mode(held[b], volume[b]));
     const RigidMode& m = modes.back();
     if (!is_weak(m)) continue;
-    char text[768];
-    int n = 0;
+    char text[256] = "";  // which body, when there are several
     if (bodies.count > 1)
-      n = std::snprintf(text, sizeof text, "body %d of %d (%ld hexes, around (%.1f, %.1f, %.1f) mm): ", b + 1,
-                        bodies.count, bodies.hexes[b], bodies.centre[b][0], bodies.centre[b][1],
-                        bodies.centre[b][2]);
+      std::snprintf(text, sizeof text, "body %d of %d (%ld hexes, around (%.1f, %.1f, %.1f) mm): ", b + 1,
+                    bodies.count, bodies.hexes[b], bodies.centre[b][0], bodies.centre[b][1],
+                    bodies.centre[b][2]);
     // The points as the report writes them (format_point): a small component is not "-0.00".
-    std::snprintf(text + n, sizeof text - n, "%s",
-                  ("the supports hold the bone only weakly against a rotation about the axis through " +
-                   format_point(m.axis_point) + " mm along " + format_point(m.direction, 2) +
-                   ": only the extent of their patches resists it")
-                      .c_str());
+    const std::string motion =
+        "the supports hold the bone only weakly against a rotation about the axis through " +
+        format_point(m.axis_point) + " mm along " + format_point(m.direction, 2) +
+        ": only the extent of their patches resists it";
     char hold[256];
     std::snprintf(hold, sizeof hold,
                   " (hold %.2g, below %.2g; the shipped scenarios 0.33 to 1.28), so the displacements and "
                   "stresses mostly measure that motion; fix more components of a support, or add a support "
                   "away from that axis",
                   m.rho, kWeakSupportHold);
-    warn(s.supports.front().where.str() + ": " + context + text + hold);
+    warn(s.supports.front().where.str() + ": " + context + text + motion + hold);
   }
   return modes;
 }
