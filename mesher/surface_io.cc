@@ -706,7 +706,13 @@ TriSurface read_ply(const std::string& path) {
       }
     }
   }
-  // ASCII data after the elements the header announces (a count too small) was dropped silently.
+  // Data after the elements the header announces (a count too small, two files joined) was dropped
+  // silently. Trailing line ends and blanks, which some exporters add after binary data, are fine.
+  if (binary && bytes.find_first_not_of(" \t\r\n", at) != std::string::npos)
+    throw InputError(quoted(path) + ": " + std::to_string(bytes.size() - at) + " bytes follow the " +
+                     "elements the header announces (from byte " + std::to_string(at) + " of " +
+                     std::to_string(bytes.size()) + "): its counts are wrong or two files were joined; " +
+                     "fix the counts or export the surface again");
   if (!binary)
     while (body.next(tok, false))
       if (!tok.empty())

@@ -425,6 +425,20 @@ TEST(SurfaceIoErrors, TruncatedBinaryPly) {
   expect_input_error([&] { read_surface(path); }, {"ends in vertex 3 (0-based) of the 8"});
 }
 
+// Bytes after a binary PLY's announced elements (a thirteenth triangle under "12 faces") were dropped
+// without a word, as ASCII lines were; a line end after the data is fine.
+TEST(SurfaceIoErrors, BytesAfterABinaryPlysElementsAreNamed) {
+  const std::string path = temp_dir() + "/more.ply";
+  write_surface(path, subdivided_cube(1));
+  const std::string bytes = read_file(path);
+  write_file(path, bytes + "\n");
+  EXPECT_EQ(read_surface(path).triangles.size(), 12u);
+  write_file(path, bytes + bytes.substr(bytes.size() - 13));
+  expect_input_error([&] { read_surface(path); },
+                     {"more.ply': 13 bytes follow the elements the header announces",
+                      "from byte " + std::to_string(bytes.size()), "fix the counts"});
+}
+
 TEST(SurfaceIoErrors, NonFiniteCoordinates) {
   const std::string dir = temp_dir();
   write_file(dir + "/nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
