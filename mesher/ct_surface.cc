@@ -425,9 +425,14 @@ VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info, const
                         (series.modality.empty() ? "no modality" : series.modality) + "), " +
                         std::to_string(series.dims[2]) + " slices";
     if (series.other_files > 0)
-      info->warnings.push_back("left out " + format_counted(std::size_t(series.other_files), "file") +
-                               " of the folder that " + (series.other_files == 1 ? "is" : "are") +
-                               " no DICOM image");
+      info->warnings.push_back(
+          "left out " + format_counted(std::size_t(series.other_files), "file") + " of the folder that " +
+          (series.other_files == 1 ? "is" : "are") + " no DICOM image" +
+          (series.empty_files.empty() ? std::string()
+                                      : " (" + std::to_string(series.empty_files.size()) +
+                                            " of them empty, '" + series.empty_files.front() +
+                                            "' first: a slice cut off by an incomplete copy? then copy the "
+                                            "series again)"));
     if (series.modality != "CT")
       info->warnings.push_back("the series' modality is " +
                                (series.modality.empty() ? std::string("not given") : series.modality) +

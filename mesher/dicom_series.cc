@@ -291,6 +291,8 @@ DicomSeries read_dicom_series(const std::string& folder, const std::string& want
     SeriesTags tags;
     if (!read_slice(file, folder, slice, tags)) {
       ++out.other_files;
+      std::error_code ec;
+      if (fs::file_size(file, ec) == 0 && !ec) out.empty_files.push_back(fs::path(file).filename().string());
       continue;
     }
     Series& s = series[tags.uid];
@@ -378,6 +380,11 @@ DicomSeries read_dicom_series(const std::string& folder, const std::string& want
           " apart where the other slices are " + mm(spacing) + " apart" +
           (missing >= 1 ? " (" + std::to_string(missing) + " slice" + (missing > 1 ? "s" : "") + " missing?)"
                         : "") +
+          (out.empty_files.empty()
+               ? std::string()
+               : "; the folder holds " + format_counted(out.empty_files.size(), "empty file") + " ('" +
+                     out.empty_files.front() + "'" + (out.empty_files.size() > 1 ? ", ..." : "") +
+                     "): an incomplete copy?") +
           "; a volume needs evenly spaced slices: export the whole series again");
     }
     // Each slice must lie straight along the normal from the first (no gantry tilt, no shift).

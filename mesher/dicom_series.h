@@ -29,6 +29,7 @@ struct DicomSeries {
   std::vector<float> values;        // rescaled: Hounsfield units for CT
   std::string series_uid, series_number, modality, description;
   int other_files = 0;  // files in the folder that are no DICOM images (a DICOMDIR, notes), left out
+  std::vector<std::string> empty_files;  // those of them that are empty (0 bytes): names in the folder
 };
 
 // Reads an image series in `folder` (every file in it, whatever its name; sub-folders are not read): the

@@ -256,6 +256,31 @@ TEST(DicomSeries, AMissingSliceIsNamedByTheFilesAroundTheGap) {
       << e;
 }
 
+// An empty slice file (a copy that stopped before the slice's first byte) was told only as a missing slice.
+TEST(DicomSeries, AnEmptySliceFileIsNamedWithTheGap) {
+  const std::string dir = written_series();
+  test::write_file(dir + "/ct_0004.dcm", "");
+  const std::string e = error_of(dir);
+  EXPECT_NE(e.find("(1 slice missing?); the folder holds 1 empty file ('ct_0004.dcm'): an incomplete copy?"),
+            std::string::npos)
+      << e;
+}
+
+// An emptied last slice leaves no gap: the volume is one slice shorter, and the warning names the file.
+TEST(DicomSeries, AnEmptyLastSliceIsNamedInTheWarning) {
+  const std::string dir = written_series();
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  test::write_file(dir + "/" + names.back(), "");
+  const auto r = test::run_hexbite({"surface", "from-ct", dir, "--threshold", "0", "-o", dir + "/../ct.stl"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("left out 1 file of the folder that is no DICOM image (1 of them empty, '" +
+                       names.back() + "' first: a slice cut off by an incomplete copy?"),
+            std::string::npos)
+      << r.err;
+}
+
 // A slice cut off inside its header (after 160 to 300 bytes): GDCM asserted and the process aborted (exit
 // 134, a backtrace from `run`). Now refused, naming the file.
 TEST(DicomSeries, ASliceCutOffInItsHeaderIsNamed) {
