@@ -38,6 +38,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/number_format.h"
+#include "common/number_parse.h"
 #include "common/paths.h"
 #include "mesher/dicom_series.h"
 #include "mesher/units.h"
@@ -229,6 +230,7 @@ void check_metaimage_header(const std::string& path) {
   int line = 0;
   std::string key;
   std::istringstream values;
+  long long ndims = 0;  // 0 until the header's NDims line
   while (next_header_entry(in, line, key, values)) {
     if (key.size() >= 255)
       throw InputError("volume '" + path + "' line " + std::to_string(line) + ": a header key of " +
@@ -236,10 +238,29 @@ void check_metaimage_header(const std::string& path) {
                        " characters (MetaImage keys are short words such as DimSize): the header is damaged; "
                        "export the volume again");
     if (key == "NDims") {
-      long long n = 0;
-      if (!(values >> n) || n < 1 || n > 3)
+      if (!(values >> ndims) || ndims < 1 || ndims > 3)
         throw InputError("volume '" + path + "' line " + std::to_string(line) + ": NDims =" + values.str() +
                          ", but a CT volume has 3 dimensions (NDims = 3): the header is damaged");
+    }
+    // MetaIO reads a number it cannot parse as the end of the header and then says "DimSize required and
+    // not defined", whichever key held it; a fractional DimSize it truncates.
+    if (key == "DimSize" || key == "Offset" || key == "Position" || key == "Origin" ||
+        key == "ElementSpacing" || key == "ElementSize" || key == "CenterOfRotation") {
+      std::vector<double> numbers;
+      std::string word;
+      bool all_numbers = true;
+      while (values >> word) {
+        double v = 0;
+        all_numbers = all_numbers && parse_double(word, v) && std::isfinite(v) &&
+                      (key != "DimSize" || (v >= 1 && std::floor(v) == v));
+        numbers.push_back(v);
+      }
+      if (!all_numbers || (ndims > 0 && static_cast<long long>(numbers.size()) != ndims))
+        throw InputError("volume '" + path + "' line " + std::to_string(line) + ": " + key + " =" +
+                         values.str() + ": expected " +
+                         (ndims > 0 ? std::to_string(ndims) + " " : std::string()) +
+                         (key == "DimSize" ? "whole numbers of at least 1" : "finite numbers") +
+                         ", one per dimension; fix the header or export the volume again");
     }
     if (key == "ElementDataFile") return;
   }

@@ -21,6 +21,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/number_parse.h"
 #include "common/paths.h"
 #include "mesher/vtk_messages.h"
 
@@ -52,13 +53,6 @@ void require_quads(const std::string& path, const QuadSurface& s) {
   if (s.quads.empty())
     throw InputError("quad surface file " + quoted(path) +
                      " contains no quads: export the surface as a quad mesh");
-}
-
-bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  const char* end = token.data() + token.size();
-  auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  return ec == std::errc() && ptr == end;
 }
 
 // An OBJ face corner is "v", "v/vt", "v//vn" or "v/vt/vn"; only the vertex index matters here.

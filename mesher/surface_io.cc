@@ -32,6 +32,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/number_parse.h"
 #include "common/paths.h"
 #include "mesher/units.h"
 #include "mesher/vtk_messages.h"
@@ -110,27 +111,6 @@ void require_triangles(const std::string& path, const TriSurface& s) {
 void add_fanned(TriSurface& s, const std::vector<int>& corners) {
   for (std::size_t i = 1; i + 1 < corners.size(); ++i)
     s.triangles.push_back({corners[0], corners[i], corners[i + 1]});
-}
-
-// Parses a whole token as a double. std::from_chars does not take a leading '+', which some
-// exporters write, and it accepts "nan" and "inf" so that such values reach require_finite().
-bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  const char* end = token.data() + token.size();
-  auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  if (ec == std::errc::result_out_of_range) {
-    // Magnitudes beyond the double range are infinite in effect; report them as such.
-    value = (!token.empty() && token.front() == '-') ? -HUGE_VAL : HUGE_VAL;
-    return ptr == end;
-  }
-  return ec == std::errc() && ptr == end;
-}
-
-bool parse_integer(std::string_view token, long long& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  const char* end = token.data() + token.size();
-  auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  return ec == std::errc() && ptr == end;
 }
 
 // Splits text into numbered lines (1-based), dropping a trailing '\r' and, when asked, a '#' comment.

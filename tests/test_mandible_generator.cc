@@ -521,6 +521,19 @@ TEST(CtVolume, DamagedHeadersAreRefusedNotACrash) {
               read_volume(dir + "/ndims.mha");
             }).find("ndims.mha' line 2: NDims = -1, but a CT volume has 3 dimensions"),
             std::string::npos);
+  // A number MetaIO cannot read was said to be "DimSize required and not defined", whichever key held it,
+  // and a fractional DimSize was truncated.
+  for (const auto& [line, fragment] : std::vector<std::pair<std::string, std::string>>{
+           {"Offset = nan 0 0", "line 4: Offset = nan 0 0: expected 3 finite numbers, one per dimension"},
+           {"ElementSpacing = 1 1", "line 4: ElementSpacing = 1 1: expected 3 finite numbers"},
+           {"DimSize = 2 2 2.5", "line 4: DimSize = 2 2 2.5: expected 3 whole numbers of at least 1"}}) {
+    test::write_file(dir + "/num.mha",
+                     "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\n" + line + "\n" + tail);
+    EXPECT_NE(
+        test::message_of<InputError>([&] { read_volume(dir + "/num.mha"); }).find("num.mha' " + fragment),
+        std::string::npos)
+        << line;
+  }
   // A 2 x 2 x 2 float NIfTI-1 file, then with one header field changed.
   std::string nifti(352, '\0');
   const auto put16 = [&](std::size_t at, int v) {
