@@ -399,23 +399,42 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& b
   return points;
 }
 
-// Everything of a level that depends only on its mesh: quality, patches and materials.
-LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh) {
+// A coarser level's patch on its refinement: the 4 children of each of its quads, so that every level of
+// the validation solves for the same patch. Selected anew on the fine boundary (facet centres within the
+// radius), the patches changed with the level (the lateral bite's nut from 57 to 44 mm2), and the change
+// between levels mixed that with the discretization error it is meant to show.
+MeshPatch refined_patch(const HexMesh& fine, const RefinementMap& map, const MeshPatch& coarse) {
+  MeshPatch patch;
+  patch.name = coarse.name;
+  for (const BoundaryQuad& quad : coarse.faces)
+    for (const auto& child : child_quads(map, quad)) patch.faces.push_back(child);
+  patch.area_mm2 = patch_area(fine, patch.faces);
+  return patch;
+}
+
+// Everything of a level that depends only on its mesh: quality, patches and materials. A refined level
+// (`coarser` given, the level it was refined from once) takes its patches from that level's.
+LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const LevelResult* coarser = nullptr) {
   LevelResult r;
   r.level = level;
   r.mesh = std::move(mesh);
   r.quality = summarize_quality(r.mesh);
   const HexBoundary boundary = extract_boundary(r.mesh);
+  const RefinementMap map = coarser ? refinement_map(coarser->mesh) : RefinementMap{};
   for (const Muscle& m : s.muscles) {
     if (m.activation <= 0) continue;
-    r.muscle_patches.push_back(select_patch(r.mesh, boundary, m.name, m.insertion.xyz, m.radius_mm,
-                                            point_place(m.insertion, m.where),
-                                            "the insertion patch of muscle '" + m.name + "'"));
+    r.muscle_patches.push_back(
+        coarser ? refined_patch(r.mesh, map, coarser->muscle_patches[r.muscle_patches.size()])
+                : select_patch(r.mesh, boundary, m.name, m.insertion.xyz, m.radius_mm,
+                               point_place(m.insertion, m.where),
+                               "the insertion patch of muscle '" + m.name + "'"));
     r.muscle_forces.push_back(muscle_force(m));
   }
   for (const Support& sup : s.supports)
-    r.support_patches.push_back(select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
-                                             point_place(sup.at, sup.where), "support '" + sup.name + "'"));
+    r.support_patches.push_back(
+        coarser ? refined_patch(r.mesh, map, coarser->support_patches[r.support_patches.size()])
+                : select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
+                               point_place(sup.at, sup.where), "support '" + sup.name + "'"));
   // Here, not before the solve: a contact that cannot push, or a probe far outside the mesh, must not cost a
   // study its earlier variants.
   r.contact_directions.assign(s.supports.size(), Vec3{0, 0, 0});
@@ -857,7 +876,7 @@ RunResult prepare_run(Scenario scenario, int levels) {
                      std::to_string(report.after.inverted) +
                      " inverted hexes; run with fewer validation levels (--levels) or another target_hexes");
     const double seconds = seconds_since(t);
-    result.levels.push_back(prepare_level(scenario, level, std::move(fine)));
+    result.levels.push_back(prepare_level(scenario, level, std::move(fine), &result.levels.back()));
     require_fixed_supports_apart(scenario, result.levels.back());
     result.levels.back().seconds_mesh = seconds;
     progress.finish(std::to_string(result.levels.back().mesh.hexes.size()) + " hexes");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
@@ -198,18 +199,14 @@ int optimize_region(HexMesh& mesh, std::vector<char> region, int rings, const st
 
 }  // namespace
 
-HexMesh refine_uniform(const HexMesh& coarse, RefinementMap* map_out) {
-  const Lattice& L = lattice();
-  const int nv = static_cast<int>(coarse.vertices.size());
-  const int nh = static_cast<int>(coarse.hexes.size());
-
+RefinementMap refinement_map(const HexMesh& coarse) {
   RefinementMap map;
-  map.coarse_vertices = nv;
-  map.coarse_hexes = nh;
-  map.edges.reserve(12 * static_cast<std::size_t>(nh));
-  map.faces.reserve(6 * static_cast<std::size_t>(nh));
+  map.coarse_vertices = static_cast<int>(coarse.vertices.size());
+  map.coarse_hexes = static_cast<int>(coarse.hexes.size());
+  map.edges.reserve(12 * coarse.hexes.size());
+  map.faces.reserve(6 * coarse.hexes.size());
   for (const auto& hex : coarse.hexes)
-    for (const LatticePoint& p : L.points) {
+    for (const LatticePoint& p : lattice().points) {
       if (p.count == 2) map.edges.push_back(lattice_key<2>(hex, p));
       if (p.count == 4) map.faces.push_back(lattice_key<4>(hex, p));
     }
@@ -217,6 +214,34 @@ HexMesh refine_uniform(const HexMesh& coarse, RefinementMap* map_out) {
   map.edges.erase(std::unique(map.edges.begin(), map.edges.end()), map.edges.end());
   std::sort(map.faces.begin(), map.faces.end());
   map.faces.erase(std::unique(map.faces.begin(), map.faces.end()), map.faces.end());
+  return map;
+}
+
+std::array<std::array<int, 4>, 4> child_quads(const RefinementMap& map, const std::array<int, 4>& quad) {
+  std::array<int, 4> key = quad;
+  std::sort(key.begin(), key.end());
+  const auto face = std::lower_bound(map.faces.begin(), map.faces.end(), key);
+  if (face == map.faces.end() || *face != key)
+    throw std::invalid_argument("child_quads: the quad is no face of the coarse mesh");
+  const int centre =
+      map.coarse_vertices + static_cast<int>(map.edges.size()) + static_cast<int>(face - map.faces.begin());
+  std::array<int, 4> mid;  // mid[k]: the midpoint of the edge from corner k to corner k + 1
+  for (int k = 0; k < 4; ++k) {
+    const int a = quad[k], b = quad[(k + 1) % 4];
+    const std::array<int, 2> edge{std::min(a, b), std::max(a, b)};
+    mid[k] = map.coarse_vertices + find_key(map.edges, edge);
+  }
+  std::array<std::array<int, 4>, 4> children;
+  for (int k = 0; k < 4; ++k) children[k] = {quad[k], mid[k], centre, mid[(k + 3) % 4]};
+  return children;
+}
+
+HexMesh refine_uniform(const HexMesh& coarse, RefinementMap* map_out) {
+  const Lattice& L = lattice();
+  const int nv = static_cast<int>(coarse.vertices.size());
+  const int nh = static_cast<int>(coarse.hexes.size());
+
+  RefinementMap map = refinement_map(coarse);
   const int first_face = nv + static_cast<int>(map.edges.size());
   const int first_cell = first_face + static_cast<int>(map.faces.size());
 

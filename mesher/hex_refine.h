@@ -45,6 +45,15 @@ struct RefinementMap {
 // One level of plain parametric refinement (no surface): the solver's validation levels.
 HexMesh refine_uniform(const HexMesh& coarse, RefinementMap* map = nullptr);
 
+// The map that refine_uniform (and each level of refine_to_surface) numbers the new vertices by.
+RefinementMap refinement_map(const HexMesh& coarse);
+
+// The 4 fine quads that a face of a coarse hex (coarse vertex ids, in cyclic order) is split into, in fine
+// vertex ids and in the face's own cyclic order (so an outward face has outward children): child k runs
+// from corner k through the midpoint of edge k, k + 1, the face's centre and the midpoint of edge k - 1, k.
+// Throws std::invalid_argument when `quad` is no face of the coarse mesh.
+std::array<std::array<int, 4>, 4> child_quads(const RefinementMap& map, const std::array<int, 4>& quad);
+
 struct RefineOptions {
   int levels = 1;
   // Coarse vertices keep their positions (the optimizer may not move them), so that the fine mesh contains

@@ -139,6 +139,35 @@ TEST(HexRefine, BoundaryIsASubmeshOfTheCoarseBoundary) {
   }
 }
 
+// child_quads gives the validation levels their patches: the children of the coarse boundary quads are
+// exactly the fine boundary quads, each once, in the cyclic order (the outward orientation) of the fine
+// boundary; on a refined level's map too.
+TEST(HexRefine, ChildQuadsAreTheFineBoundaryQuadsWithTheirOrientation) {
+  HexMesh coarse = block(3, 2, 4);
+  for (int level = 0; level < 2; ++level) {
+    const RefinementMap map = refinement_map(coarse);
+    const HexMesh fine = refine_uniform(coarse);
+    const HexBoundary cb = extract_boundary(coarse), fb = extract_boundary(fine);
+    // Each fine boundary quad as its vertex ids rotated to start at the smallest: orientation kept.
+    auto canonical = [](std::array<int, 4> q) {
+      std::rotate(q.begin(), std::min_element(q.begin(), q.end()), q.end());
+      return q;
+    };
+    std::set<std::array<int, 4>> fine_quads;
+    for (const auto& q : fb.surface.quads)
+      fine_quads.insert(canonical({fb.boundary_vertices[q[0]], fb.boundary_vertices[q[1]],
+                                   fb.boundary_vertices[q[2]], fb.boundary_vertices[q[3]]}));
+    std::set<std::array<int, 4>> children;
+    for (const auto& q : cb.surface.quads)
+      for (const auto& child : child_quads(map, {cb.boundary_vertices[q[0]], cb.boundary_vertices[q[1]],
+                                                 cb.boundary_vertices[q[2]], cb.boundary_vertices[q[3]]}))
+        EXPECT_TRUE(children.insert(canonical(child)).second) << "a child twice";
+    EXPECT_EQ(children, fine_quads) << "level " << level;
+    coarse = fine;
+  }
+  EXPECT_THROW(child_quads(refinement_map(coarse), {0, 1, 2, 3}), std::invalid_argument);
+}
+
 TEST(HexRefine, DistortedMeshKeepsItsVolumeExactly) {
   // The children are the parent's trilinear map restricted to its octants, so the volume is exact for any
   // hexes, not only for parallelepipeds.
