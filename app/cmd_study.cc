@@ -143,9 +143,8 @@ void run_study(const StudyCliOptions& o) {
     for (const char* name : {"study.csv", "study.md", "study.json"}) files.push_back(name);  // json last
     // An earlier study's output files in a variant's folder that this one does not rewrite go; the tables
     // are always rewritten, and everything else (other folders, your own files) stays.
-    stage.commit(files, [](const std::string& name) {
-      const std::size_t slash = name.find('/');
-      return slash != std::string::npos && is_run_output_name(name.substr(slash + 1));
+    stage.commit(files, [&](const std::string& name) {
+      return name.find('/') != std::string::npos && is_earlier_run_output(stage.dir(), name);
     });
 
     if (o.json) {

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -421,10 +422,13 @@ void broadcast(std::string* text, int root) {
 
 }  // namespace
 
-bool is_run_output_name(const std::string& name) {
+bool is_earlier_run_output(const std::string& dir, const std::string& name) {
   static const std::regex kOutputName(
       R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
-  return std::regex_match(name, kOutputName);
+  const std::filesystem::path path = std::filesystem::path(dir) / name;
+  std::error_code ec;
+  return std::regex_match(path.filename().string(), kOutputName) &&
+         std::filesystem::is_regular_file(path.parent_path() / "results.json", ec);
 }
 
 RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
@@ -526,7 +530,7 @@ void RunOutputs::commit(const std::string& results_text) {
         if (!root) return;
         std::vector<std::string> files = files_;
         files.push_back("results.json");  // last: a script that waits for it finds the whole set
-        stage_->commit(files, is_run_output_name);
+        stage_->commit(files, [&](const std::string& name) { return is_earlier_run_output(dir_, name); });
       },
       kCommitNote);
 }

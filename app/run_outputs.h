@@ -25,9 +25,11 @@ void check_inp_exportable(const Scenario& scenario);
 // results.json. `seconds_output` is the time spent writing the files (reported under seconds.output).
 nlohmann::json results_json(const RunResult& result, double seconds_output);
 
-// The names of the files a run may write but results.json (which every run writes): those of an earlier run
-// into the same folder that this run does not rewrite are removed when this run's set is moved in.
-bool is_run_output_name(const std::string& name);
+// Whether `name` (relative to `dir`, "solution_level2.vtu" or, for a study, "soft_bone/model.inp") is an
+// earlier run's output, which a run into the same folder that does not rewrite it removes when its own set is
+// moved in: a name a run may write but results.json (which every run writes), in a folder that holds a
+// results.json. Without that a folder held no run: the user's own model.inp there was removed.
+bool is_earlier_run_output(const std::string& dir, const std::string& name);
 
 // The files of a run into DIR, all or nothing. Every rank constructs one and calls write() and commit()
 // together. An error of any rank (disk full, a folder in the way of a file name) makes every rank throw

@@ -786,7 +786,8 @@ muscles:
 }
 
 // A run into the folder of an earlier run with more levels, --export inp or more ranks left that run's
-// solution_level1.vtu, model.inp and pieces beside the new files, as if they belonged to them.
+// solution_level1.vtu, model.inp and pieces beside the new files, as if they belonged to them; the same
+// names in a folder that held no run are the user's and stay.
 TEST(RunScenario, FilesOfAnEarlierRunThatThisRunDoesNotWriteAreRemoved) {
   const std::string dir = test::temp_dir();
   const std::string out = dir + "/out";
@@ -797,6 +798,12 @@ TEST(RunScenario, FilesOfAnEarlierRunThatThisRunDoesNotWriteAreRemoved) {
   for (const std::string& name : stale) test::write_file(out + "/" + name, "old\n");
   test::write_file(out + "/notes.txt", "mine\n");
   test::write_file(dir + "/small.yaml", kSmall);
+  // A folder without results.json held no run: its files of those names are the user's own (a CalculiX
+  // deck in its working folder), and were removed without a word.
+  ASSERT_TRUE(run_scenario(dir + "/small.yaml", out).is_object());
+  for (const std::string& name : stale) EXPECT_EQ(test::read_file(out + "/" + name), "old\n") << name;
+  // Now the folder holds a run: the files of those names are an earlier run's.
+  for (const std::string& name : stale) test::write_file(out + "/" + name, "old\n");
   ASSERT_TRUE(run_scenario(dir + "/small.yaml", out).is_object());
   for (const std::string& name : stale) EXPECT_FALSE(fs::exists(out + "/" + name)) << name;
   for (const char* name : {"notes.txt", "results.json", "mesh.vtu", "solution.vtu"})
