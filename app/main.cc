@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <csignal>
+#include <cstdio>
 #include <functional>
 #include <iostream>
 #include <optional>
@@ -122,9 +124,25 @@ std::optional<std::string> missing_command_message(const CLI::App& app) {
   return "a command is required; " + list;
 }
 
+// Standard output holds what a script reads (`--json`, the tables, --help): when it could not be written
+// (a full disk behind `> file`, a closed descriptor), the command failed, though its files were written.
+// Exit 0 with a JSON document cut off at 4,096 bytes is what a script could not tell from success.
+int checked_stdout(int exit_code) {
+  std::cout.flush();
+  const bool written = static_cast<bool>(std::cout) && std::fflush(stdout) == 0 && !std::ferror(stdout);
+  if (written || exit_code != hexbite::kExitOk) return exit_code;
+  std::cerr << "hexbite: failed: cannot write to standard output (a full disk, or the output closed): what "
+               "it printed is incomplete; make room, or redirect it elsewhere\n";
+  return hexbite::kExitRunFailed;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Past a file size limit (ulimit -f) a write raises SIGXFSZ, which killed the process without a word and
+  // left its temporary files; ignored, the write fails with EFBIG and the outputs are undone as on a full
+  // disk.
+  std::signal(SIGXFSZ, SIG_IGN);
   std::optional<hexbite::MpiSession> mpi;
   if (command_uses_solver(argc, argv)) mpi.emplace(argc, argv);
   // Only rank 0 reports progress and results; an error met by every rank alike is reported once (report).
@@ -157,11 +175,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return checked_stdout(app.exit(e));
   } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return checked_stdout(app.exit(e));
   } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
+    return checked_stdout(app.exit(e));
   } catch (const CLI::ArgumentMismatch& e) {
     std::ostringstream text;
     const std::optional<std::string> repeated = repeated_option_message(app);
@@ -185,5 +203,5 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return report(std::string("hexbite: failed: ") + e.what() + '\n', hexbite::kExitRunFailed, errors);
   }
-  return hexbite::kExitOk;
+  return checked_stdout(hexbite::kExitOk);
 }

@@ -482,10 +482,11 @@ void RunOutputs::on_all_ranks(const std::function<void()>& step, Note note) {
   if (kind == 0) return;
   message = named_in_dir(message, stage_dir_, dir_);
   if (note != kNoNote)
-    message +=
-        "; the run kept none of its files and " +
-        (created_dir_ ? "did not create '" + dir_ + "'" : "left '" + dir_ + "' as it was") +
-        (note == kWriteNote ? ": make room on the disk or choose another output folder, and run again" : "");
+    message += "; the run kept none of its files and " +
+               (created_dir_ ? "did not create '" + dir_ + "'" : "left '" + dir_ + "' as it was") +
+               (note == kWriteNote && message.find(kWriteAdvice) == std::string::npos
+                    ? std::string(": ") + kWriteAdvice + ", and run again"
+                    : "");
   if (kind == 2) throw InputError(message);
   throw RunError(message);
 }

@@ -59,7 +59,7 @@ void write_file_atomically(const std::string& final_path, const std::string& con
                      "' beside it to write into first)");
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.close();
-    if (!out) throw RunError("cannot write '" + final_path + "': disk full or not writable");
+    if (!out) throw RunError("cannot write '" + final_path + "': " + kWriteFailed + ": " + kWriteAdvice);
   });
 }
 

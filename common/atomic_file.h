@@ -16,6 +16,10 @@ void write_atomically(const std::string& final_path, const std::function<void(co
 // allows (a 250-byte name is a valid output; its temporary name with ".tmpPID" added was not).
 std::string temporary_path_beside(const std::string& final_path, const std::string& extension);
 
+// Why a write failed when the stream says only that it failed, and what to do.
+inline constexpr const char* kWriteFailed = "the disk is full or the file passed a size limit (ulimit -f)";
+inline constexpr const char* kWriteAdvice = "make room on the disk or choose another output folder";
+
 // Convenience: writes a whole text or binary string atomically.
 void write_file_atomically(const std::string& final_path, const std::string& contents);
 

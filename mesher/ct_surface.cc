@@ -612,6 +612,7 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
   const fs::path raw = dir / (stem + ".zraw");
 
   auto image = to_image(volume, 0, 0.0f);
+  bool write_failed = false;
   ErrorCatcher errors;
   const VtkMessageCapture muted;
   if (fmt.format == VolumeFormat::kMetaImage) {
@@ -621,7 +622,11 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
     writer->SetCompression(true);
     writer->SetFileName(tmp.c_str());
     if (fmt.extension != ".mha" && fmt.extension != ".MHA") writer->SetRAWFileName(raw.c_str());
+    // MetaIO tells a failed write (a full disk: "file stream is fail after write") only on standard error,
+    // and the cut-off file was kept with exit 0.
+    const CerrCapture metaio;
     writer->Write();
+    write_failed = metaio.said("fail");
   } else {
     // The grid's placement goes into the qform; VTK's NIfTI writer ignores the image origin.
     auto qform = vtkSmartPointer<vtkMatrix4x4>::New();
@@ -635,13 +640,14 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
     writer->Write();
   }
   std::error_code ec;
-  if (!errors.message.empty() || !fs::exists(tmp)) {
+  if (!errors.message.empty() || !fs::exists(tmp) || write_failed) {
     fs::remove(tmp, ec);
     if (fmt.extension == ".mhd" || fmt.extension == ".MHD") fs::remove(raw, ec);
     // VTK's writers add ", removing incomplete file .NAME.tmpPID.nii": the temporary name means nothing to
     // the user, whose file of that name is untouched.
     std::string reason = first_line(errors.message);
     reason = reason.substr(0, reason.find(", removing incomplete file"));
+    if (write_failed) reason = std::string(kWriteFailed) + ": " + kWriteAdvice;
     throw RunError("cannot write volume '" + path + "'" + (reason.empty() ? std::string() : ": " + reason));
   }
   fs::rename(tmp, target, ec);

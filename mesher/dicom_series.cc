@@ -17,6 +17,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/number_format.h"
 
@@ -479,8 +480,16 @@ std::vector<std::string> write_dicom_series(const std::string& folder, const Vox
     char file[32];
     std::snprintf(file, sizeof file, "ct_%04d.dcm", k + 1);
     const std::string path = (fs::path(folder) / file).string();
-    writer.SetFileName(path.c_str());
-    if (!writer.Write()) throw RunError("cannot write '" + path + "': disk full or not writable");
+    // Into memory first: GDCM's writer asserts (the process aborted, exit 134) when its file stream fails
+    // on a full disk; the bytes are then written and checked here.
+    std::ostringstream bytes;
+    writer.SetStream(bytes);
+    if (!writer.Write()) throw RunError("cannot write '" + path + "': GDCM could not encode the slice");
+    const std::string encoded = bytes.str();
+    std::ofstream out(path, std::ios::binary);
+    out.write(encoded.data(), static_cast<std::streamsize>(encoded.size()));
+    out.close();
+    if (!out) throw RunError("cannot write '" + path + "': " + kWriteFailed + ": " + kWriteAdvice);
     names.push_back(file);
   }
   return names;

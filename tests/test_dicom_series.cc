@@ -256,6 +256,18 @@ TEST(DicomSeries, AMissingSliceIsNamedByTheFilesAroundTheGap) {
       << e;
 }
 
+// GDCM's writer asserted on a full disk (the process aborted, exit 134, the slices written so far left).
+TEST(DicomSeries, AFailedSliceWriteIsAnError) {
+  const std::string dir = test::temp_dir();
+  std::string message;
+  {
+    const test::FileSizeLimit limit(100);
+    message = test::message_of<RunError>([&] { write_dicom_series(dir, test_volume(), rescaled()); });
+  }
+  EXPECT_NE(message.find("cannot write '" + dir + "/ct_0001.dcm': the disk is full"), std::string::npos)
+      << message;
+}
+
 // An empty slice file (a copy that stopped before the slice's first byte) was told only as a missing slice.
 TEST(DicomSeries, AnEmptySliceFileIsNamedWithTheGap) {
   const std::string dir = written_series();

@@ -579,6 +579,34 @@ VoxelVolume ramp_volume() {
   return v;
 }
 
+// A MetaImage write that failed (a full disk) was told by MetaIO on standard error only, and the cut-off
+// file was kept: `generate mandible --ct` exited 0. Now an error, and nothing is left.
+TEST(CtVolume, AFailedVolumeWriteIsAnErrorAndLeavesNothing) {
+  VoxelVolume v;
+  v.dims = {40, 40, 40};
+  v.spacing = 0.5;
+  std::uint32_t state = 12345;  // noise, which compression cannot shrink below the limit
+  for (int i = 0; i < 40 * 40 * 40; ++i) {
+    state = state * 1664525u + 1013904223u;
+    v.values.push_back(static_cast<float>(state >> 8));
+  }
+  const std::string dir = test::temp_dir();
+  for (const char* name : {"/ct.mha", "/ct.mhd", "/ct.nii"}) {
+    std::string message;
+    {
+      const test::FileSizeLimit limit(20000);
+      message = test::message_of<RunError>([&] { write_volume(dir + name, v); });
+    }
+    EXPECT_NE(message.find("cannot write volume '" + dir + name + "'"), std::string::npos) << message;
+    EXPECT_TRUE(fs::is_empty(dir)) << name;
+  }
+  const std::string mha = test::message_of<RunError>([&] {
+    const test::FileSizeLimit limit(20000);
+    write_volume(dir + "/ct.mha", v);
+  });
+  EXPECT_NE(mha.find("the disk is full or the file passed a size limit"), std::string::npos) << mha;
+}
+
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -836,9 +864,11 @@ TEST(Cli, GenerateWritesAllItsOutputsOrNone) {
   r = test::run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--ct", dir + "/jaw.mha"},
                         {"bash", "-c", "trap '' XFSZ; ulimit -f 500; exec \"$@\"", "bash"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_EQ(r.err, "hexbite: failed: cannot write '" + dir +
-                       "/jaw.stl': disk full or not writable; none of the outputs was written (files of "
-                       "those names are as they were)\n");
+  EXPECT_EQ(r.err,
+            "hexbite: failed: cannot write '" + dir +
+                "/jaw.stl': the disk is full or the file passed a size limit (ulimit -f): make room on the "
+                "disk or choose another output folder; none of the outputs was written (files of "
+                "those names are as they were)\n");
   test::expect_same_files(before, test::files_under(dir));
 }
 

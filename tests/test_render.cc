@@ -230,7 +230,9 @@ TEST(Render, AnUnwritablePictureIsOneCleanError) {
             1);
   log = read_file(dir + "/log");
   EXPECT_EQ(log,
-            "hexbite: failed: cannot write '" + png + "': disk full or not writable\n");  // no libpng lines
+            "hexbite: failed: cannot write '" + png +
+                "': the disk is full or the file passed a size limit (ulimit -f): make room on the disk or "
+                "choose another output folder\n");         // no libpng lines
   EXPECT_EQ(log.find("\x1b["), std::string::npos) << log;  // no terminal colour codes
   EXPECT_FALSE(fs::exists(png));
 }

@@ -860,12 +860,12 @@ TEST(RunScenario, AWriteThatFailsLeavesTheEarlierRunUntouchedAndCreatesNoFolder)
   test::write_file(dir + "/stiff.yaml", kSmall + "materials:\n  default: {E_MPa: 15000}\n");
   const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/stiff.yaml", "-o", out}, limited);
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find(
-                "hexbite: failed: cannot write '" + out +
-                "/solution.vtu': disk full or not writable; the run kept none of its files and left '" + out +
-                "' as it was: make room on the disk or choose another output folder, and run "
-                "again\n"),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find("hexbite: failed: cannot write '" + out +
+                 "/solution.vtu': the disk is full or the file passed a size limit (ulimit -f): make room "
+                 "on the disk or choose another output folder; the run kept none of its files and left '" +
+                 out + "' as it was\n"),
+      std::string::npos)
       << r.err;
   test::expect_same_files(before, test::files_under(out));
 

@@ -1,9 +1,11 @@
 #include "tests/test_util.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -102,6 +104,22 @@ void expect_same_files(const std::map<std::string, std::string>& before,
   }
   for (const auto& [name, contents] : after)
     if (before.count(name) == 0) ADD_FAILURE() << name << " is new";
+}
+
+FileSizeLimit::FileSizeLimit(unsigned long long bytes) {
+  std::signal(SIGXFSZ, SIG_IGN);
+  rlimit limit{};
+  getrlimit(RLIMIT_FSIZE, &limit);
+  soft_ = limit.rlim_cur;
+  limit.rlim_cur = bytes;
+  setrlimit(RLIMIT_FSIZE, &limit);
+}
+
+FileSizeLimit::~FileSizeLimit() {
+  rlimit limit{};
+  getrlimit(RLIMIT_FSIZE, &limit);
+  limit.rlim_cur = soft_;
+  setrlimit(RLIMIT_FSIZE, &limit);
 }
 
 std::string cubes_obj(int cubes) {

@@ -41,6 +41,19 @@ void expect_same_files(const std::map<std::string, std::string>& before,
 // Separate 20 mm cubes (x 0-20, 40-60, ...) as OBJ text, outward triangles.
 std::string cubes_obj(int cubes);
 
+// While it lives, files this process writes may not grow beyond `bytes` (setrlimit RLIMIT_FSIZE, with
+// SIGXFSZ ignored as hexbite's main does): a write past it fails as on a full disk.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(unsigned long long bytes);
+  ~FileSizeLimit();
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  unsigned long long soft_ = 0;
+};
+
 // The message of the exception of type E that f() throws; a test failure, and "", when it throws none.
 template <class E, class F>
 std::string message_of(F f) {
