@@ -42,7 +42,7 @@ struct RefinementMap {
   std::vector<std::array<int, 4>> faces;
 };
 
-// One level of plain parametric refinement (no surface): the solver's validation levels.
+// One level of plain parametric refinement (no surface); refine_to_surface runs it once per level.
 HexMesh refine_uniform(const HexMesh& coarse, RefinementMap* map = nullptr);
 
 // The map that refine_uniform (and each level of refine_to_surface) numbers the new vertices by.
