@@ -22,6 +22,7 @@
 #include "mesher/ct_surface.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_boundary.h"
+#include "mesher/hex_point_location.h"
 #include "mesher/hex_quality.h"
 #include "mesher/hex_refine.h"
 #include "mesher/landmarks.h"
@@ -356,30 +357,48 @@ constexpr double kProbeMaxOutsideMm = 5.0;
 
 // Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
 // nodes on the surface) runs up to a millimetre or two inside it, so such a point is often just outside the
-// mesh. A point outside is moved to the closest point of the mesh boundary, then 1 % of the way toward the
-// centre of the hex behind it, so that one hex contains it; results.json reports the requested point and
-// the distance moved. A point farther outside than kProbeMaxOutsideMm is refused at its line.
+// mesh. A point that no hex holds is moved to the nearest point inside a hex near it (its unit coordinates
+// clamped just inside the unit cube: mesher/hex_point_location.h), so that the solver evaluates it exactly
+// there; results.json reports that point and the distance moved. (It was moved onto the fan-triangulated
+// boundary and 1 % toward the hex's centre, which on a warped boundary quad could still lie outside the
+// curved hex: evaluated 0.02 mm elsewhere, or, 0.6 mm out, not at all, with zeros written.) A point farther
+// outside than kProbeMaxOutsideMm is refused at its line.
 std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& boundary,
                                        const std::vector<Probe>& probes) {
   std::vector<Vec3> points;
   if (probes.empty()) return points;
   const SurfaceProjector mesh_boundary(fan_triangles(boundary.surface));
+  std::vector<std::array<Vec3, 2>> boxes(mesh.hexes.size());  // each hex's bounding box
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    boxes[h] = {mesh.vertices[mesh.hexes[h][0]], mesh.vertices[mesh.hexes[h][0]]};
+    for (int v : mesh.hexes[h])
+      for (int a = 0; a < 3; ++a) {
+        boxes[h][0][a] = std::min(boxes[h][0][a], mesh.vertices[v][a]);
+        boxes[h][1][a] = std::max(boxes[h][1][a], mesh.vertices[v][a]);
+      }
+  }
+  // The hexes whose bounding box, grown by `margin`, holds p.
+  const auto hexes_near = [&](const Vec3& p, double margin) {
+    std::vector<int> near;
+    for (std::size_t h = 0; h < boxes.size(); ++h) {
+      bool in = true;
+      for (int a = 0; a < 3; ++a) in &= p[a] >= boxes[h][0][a] - margin && p[a] <= boxes[h][1][a] + margin;
+      if (in) near.push_back(static_cast<int>(h));
+    }
+    return near;
+  };
   for (const Probe& probe : probes) {
     const Vec3& p = probe.at.xyz;
-    if (mesh_boundary.inside(p)) {
+    const double scale = 1e-9 * (1.0 + vec3::norm(p));
+    const std::vector<int> holding = hexes_near(p, scale);
+    if (std::any_of(holding.begin(), holding.end(), [&](int h) { return hex_holds(mesh, h, p); })) {
       points.push_back(p);
       continue;
     }
     const SurfacePoint foot = mesh_boundary.closest(p);
     // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
     // away is a typo or a point of another frame, and its values would be those of an unrelated place.
-    const double outside = vec3::norm(vec3::sub(foot.point, p));
-    // On the boundary (a boundary node, a point of a boundary face) is in the mesh: it was moved 0.02-0.05
-    // mm inward and its values taken there, with `moved_mm` saying so.
-    if (outside <= 1e-9 * (1.0 + vec3::norm(p))) {
-      points.push_back(p);
-      continue;
-    }
+    const double outside = mesh_boundary.inside(p) ? 0.0 : vec3::norm(vec3::sub(foot.point, p));
     if (outside > kProbeMaxOutsideMm) {
       char buf[400];
       std::snprintf(
@@ -391,10 +410,15 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& b
           kProbeMaxOutsideMm);
       throw InputError(point_place(probe.at, probe.where).str() + buf);
     }
-    const Vec3 centre = hex_centroid(mesh, boundary.quad_face[foot.triangle / 4][0]);
-    Vec3 moved;
-    for (int a = 0; a < 3; ++a) moved[a] = foot.point[a] + 0.01 * (centre[a] - foot.point[a]);
-    points.push_back(moved);
+    // The trilinear hexes bulge beyond their fan-triangulated faces by a fraction of a millimetre; 2 mm
+    // more than the distance to the triangles takes in every hex the nearest point can lie in.
+    std::vector<int> near = hexes_near(p, outside + 2.0);
+    near.push_back(boundary.quad_face[foot.triangle / 4][0]);  // the hex behind the nearest triangle
+    const PointInHex inside = nearest_point_inside(mesh, near, p);
+    if (inside.hex < 0)
+      throw RunError(point_place(probe.at, probe.where).str() + ": probe '" + probe.name +
+                     "' could not be placed in a hex of the mesh near it; move it into the bone");
+    points.push_back(inside.point);
   }
   return points;
 }
@@ -892,6 +916,13 @@ void solve_run(RunResult& result) {
   const Scenario& s = result.scenario;
   for (LevelResult& level : result.levels) {
     solve_level(s, level);
+    // Every probe is placed in a hex before the solve (probe_points_in_mesh); one the solver still does not
+    // find has no values, and its zeros in results.json must not pass for measured ones.
+    for (std::size_t i = 0; i < s.probes.size(); ++i)
+      if (!level.solution.probes[i].found)
+        warn(point_place(s.probes[i].at, s.probes[i].where).str() + ": probe '" + s.probes[i].name +
+             "' was not found in the level " + std::to_string(level.level) +
+             " mesh: it has no values (found: false in results.json); move it into the bone");
     // The hold measured before the solve was of every support; with contacts released the bone may hang
     // on a few patches (an opening load lifting the teeth off their contacts): measured again, and
     // results.json's support_hold is then of the coarse level as solved.

@@ -23,6 +23,7 @@
 #include "common/system_memory.h"
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_point_location.h"
 #include "postprocess/report_format.h"
 #include "tests/test_util.h"
 
@@ -446,6 +447,54 @@ supports:
   - {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}
   - {name: left_condyle, at: left_condyle_tmj_point, radius_mm: 6}
 )";
+
+// A probe 0.6 mm outside a warped boundary quad was moved onto the quad's fan triangles and 1 % toward the
+// hex's centre, which left it outside the curved hex: the solver did not find it and results.json gave it
+// zeros with exit 0 (helper J). Others were evaluated 0.02 mm from the `at` reported. Now `at` lies in a
+// hex, `moved_mm` is its distance from the requested point, and the values are the solution's there.
+TEST(RunScenario, AProbeOutsideTheMeshIsEvaluatedInsideAtTheReportedPoint) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/probe.yaml", R"(name: probe_outside
+geometry:
+  mandible: {variant: dentate}
+mesh: {method: grid, core: auto, target_hexes: 2000, validation_levels: 0}
+activation_pattern:
+  superficial_masseter: {right: 0.56, left: 0.20}
+  medial_pterygoid: {right: 0.97, left: 0.47}
+supports:
+  - {name: nut, at: right_first_molar_bite_point, radius_mm: 4, bite: true}
+  - {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}
+  - {name: left_condyle, at: left_condyle_tmj_point, radius_mm: 6}
+probes:
+  - {name: outside, at: [44.542941, -2.690435, 42.670148]}
+  - {name: incisal, at: incisal_point}
+)");
+  const json r = run_scenario(dir + "/probe.yaml", dir + "/out");
+  ASSERT_TRUE(r.is_object());
+  std::vector<MeshArray> cells, points;
+  const HexMesh mesh = read_vtu(dir + "/out/solution.vtu", &cells, &points);
+  const MeshArray& u = array(points, "displacement");
+  for (const auto& [name, probe] : r["probes"].items()) {
+    SCOPED_TRACE(name);
+    EXPECT_TRUE(probe["found"].get<bool>());
+    const Vec3 at = vec(probe["at"]), requested = vec(probe["requested_at"]);
+    EXPECT_NEAR(probe["moved_mm"].get<double>(), vec3::norm(vec3::sub(at, requested)), 1e-12);
+    int holder = -1;
+    for (std::size_t h = 0; h < mesh.hexes.size() && holder < 0; ++h)
+      if (hex_holds(mesh, static_cast<int>(h), at)) holder = static_cast<int>(h);
+    ASSERT_GE(holder, 0) << "the reported point lies in no hex";
+    const std::optional<Vec3> unit = trilinear_unit(mesh, holder, at);
+    ASSERT_TRUE(unit.has_value());
+    // The displacement there, interpolated from the hex's nodes, is the one reported.
+    HexMesh field = mesh;
+    for (std::size_t v = 0; v < field.vertices.size(); ++v)
+      field.vertices[v] = {u.values[3 * v], u.values[3 * v + 1], u.values[3 * v + 2]};
+    const Vec3 expected = trilinear_point(field, holder, *unit), got = vec(probe["displacement_mm"]);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], expected[a], 1e-9 * vec3::norm(expected)) << a;
+  }
+  // The nearest point of the curved hexes, 0.617 mm away by a search on the bilinear boundary quads.
+  EXPECT_NEAR(r["probes"]["outside"]["moved_mm"].get<double>(), 0.617, 0.01);
+}
 
 // A bad scenario exits with 2, names the file and line, and leaves no output folder behind. Returns the
 // error message.
