@@ -693,8 +693,9 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
     char hold[256];
     std::snprintf(hold, sizeof hold,
                   " (hold %.2g, below %.2g; the shipped scenarios 0.33 to 1.28), so the displacements and "
-                  "stresses mostly measure that motion; fix more components of a support, or add a support "
-                  "away from that axis",
+                  "stresses depend mostly on how the patches resist that rotation. A body clamped at one end "
+                  "(a cantilever) is held so by design; otherwise fix more components of a support, or add a "
+                  "support away from that axis",
                   m.rho, kWeakSupportHold);
     warn(s.supports.front().where.str() + ": " + context + text + motion + hold);
   }

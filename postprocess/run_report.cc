@@ -364,10 +364,12 @@ std::vector<std::string> report_warnings(const RunFigures& r) {
                                    ? "a rotation about the axis through " + format_point(*h.axis_point) +
                                          " mm along " + format_point(h.direction, 2)
                                    : "a translation along " + format_point(h.direction, 2);
-    w.push_back("Weak supports: the supports" + body + " hold the bone only weakly (hold " + hold +
-                ", below 0.02) against " + motion +
-                "; the displacements and stresses then mostly measure that motion: fix more components of a "
-                "support (docs/scenario-format.md, \"Weak supports\").");
+    w.push_back(
+        "Weak supports: the supports" + body + " hold the bone only weakly (hold " + hold +
+        ", below 0.02) against " + motion +
+        "; the displacements and stresses then depend mostly on how the patches resist that motion. "
+        "A body clamped at one end (a cantilever) is held so by design; otherwise fix more components "
+        "of a support (docs/scenario-format.md, \"Weak supports\").");
   }
   for (const LevelFigures& l : r.levels)
     if (!(l.equilibrium_residual <= kReportEquilibriumLimit))
