@@ -13,7 +13,9 @@ namespace hexbite {
 
 namespace {
 
-using nlohmann::json;
+// Ordered: a study variant's `set` is listed in the order its changes apply (sorted, a report read
+// "supports.nut: {at: right ...}; supports.nut.at: left ..." for the reverse order, which put the nut left).
+using json = nlohmann::ordered_json;
 
 // A value of the file with its key path, for messages ("validation.levels[1].hexes").
 struct Key {

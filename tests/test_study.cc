@@ -209,6 +209,24 @@ TEST_F(CubeStudy, AVariantsResultsAndReportNameTheStudyAndTheChanges) {
   }
 }
 
+// The report lists a variant's changes in the order they apply: it sorted them, and "supports.nut: {at:
+// right}; supports.nut.at: left" read as a nut on the left for a run with it on the right (helper L).
+TEST_F(CubeStudy, AReportListsAVariantsChangesInTheOrderTheyApply) {
+  const std::string folder = *dir_ + "/ordered";
+  fs::copy(*dir_ + "/out/soft", folder, fs::copy_options::recursive);
+  nlohmann::ordered_json results = nlohmann::ordered_json::parse(test::read_file(folder + "/results.json"));
+  results["study"]["set"] = nlohmann::ordered_json::object();
+  results["study"]["set"]["materials.default.poisson"] = 0.3;
+  results["study"]["set"]["materials.default.E_MPa"] = 5500;
+  test::write_file(folder + "/results.json", results.dump(2));
+  const std::string html = *dir_ + "/ordered.html";
+  const test::CommandResult r = test::run_hexbite({"-q", "report", folder, "-o", html, "--no-pictures"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(test::read_file(html).find(
+                "the scenario with materials.default.poisson: 0.3; materials.default.E_MPa: 5500"),
+            std::string::npos);
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
