@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "solver/mpi_session.h"
@@ -143,6 +144,7 @@ int main(int argc, char** argv) {
   // left its temporary files; ignored, the write fails with EFBIG and the outputs are undone as on a full
   // disk.
   std::signal(SIGXFSZ, SIG_IGN);
+  hexbite::remove_temporary_files_on_signals();
   std::optional<hexbite::MpiSession> mpi;
   if (command_uses_solver(argc, argv)) mpi.emplace(argc, argv);
   // Only rank 0 reports progress and results; an error met by every rank alike is reported once (report).

@@ -10,6 +10,11 @@ namespace hexbite {
 // when write returns; removes the temporary file if write throws. The directory must exist.
 void write_atomically(const std::string& final_path, const std::function<void(const std::string&)>& write);
 
+// Installs handlers for SIGINT, SIGTERM and SIGHUP (Ctrl-C, a batch system's time limit, a closed terminal)
+// that remove the temporary files write_atomically is writing, then end the process as the signal would:
+// an interrupted write left a hidden '.NAME.tmpPID.vtu' that nothing removed.
+void remove_temporary_files_on_signals();
+
 // The temporary name beside `final_path` that its content is written to first: hidden, with the process id,
 // ending in `extension` (the format's, ".vtu" or ".nii.gz": some writers choose the format from it). The
 // final name's stem is shortened when the temporary name would be longer than the folder's file system

@@ -3,12 +3,16 @@
 #include "common/output_stage.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <map>
 #include <string>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "tests/test_util.h"
 
@@ -19,6 +23,28 @@ namespace fs = std::filesystem;
 
 bool is_output(const std::string& name) {
   return name.rfind("out_", 0) == 0;
+}
+
+// Ctrl-C or a batch system's SIGTERM while a file was being written left its hidden temporary file, which
+// nothing removed (helper K). A child process writes, and is signalled in the middle of the write.
+TEST(AtomicFile, ASignalDuringAWriteRemovesTheTemporaryFile) {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    const std::string dir = test::temp_dir();
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      remove_temporary_files_on_signals();
+      write_atomically(dir + "/out.vtu", [&](const std::string& tmp) {
+        test::write_file(tmp, "half a file");
+        std::raise(signal_number);
+      });
+      std::_Exit(0);  // not reached: the signal ends the process
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number) << signal_number;
+    EXPECT_TRUE(fs::is_empty(dir)) << "a temporary file was left, signal " << signal_number;
+  }
 }
 
 TEST(OutputStage, CommitMovesTheSetInAndRemovesTheEarlierRunsOtherOutputs) {
