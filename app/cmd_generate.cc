@@ -125,8 +125,16 @@ void run_generate(const GenerateArgs& args) {
   params = complete_parameters(params);
   const std::string landmark_path =
       args.landmarks.empty() ? default_landmark_path(args.output) : args.landmarks;
-  // Every output path was checked while parsing (app/option_checks.h), so a mistake in one of them is found
-  // before any work; the default landmark path shares the checked output's folder.
+  // Every output path given was checked while parsing (app/option_checks.h), so a mistake in one of them
+  // is found before any work. The default landmark path is checked here, before the work too: a folder of
+  // that name, or a name too long for the file system, failed only after the mandible was made (exit 1).
+  if (args.landmarks.empty()) {
+    std::string path = landmark_path;
+    const std::string problem = output_file({".yaml"})(path);
+    if (!problem.empty())
+      throw InputError(problem +
+                       " (the landmark file's default name, from -o); give --landmarks another path");
+  }
 
   const auto start = std::chrono::steady_clock::now();
   Progress progress("generate mandible");

@@ -153,6 +153,12 @@ CLI::Validator output_folder() {
         // the path's deepest existing part is looked at now.
         fs::path existing = value;
         while (!fs::exists(existing, ec)) {
+          // A dangling link (or a loop of links) on the path was found only when the folder was made,
+          // after the whole run: "cannot create the output folder 'dl': File exists", exit 1.
+          if (fs::is_symlink(fs::symlink_status(existing, ec)))
+            return "cannot create the output folder '" + value + "': '" + existing.string() +
+                   "' is a link to '" + fs::read_symlink(existing, ec).string() +
+                   "', which does not exist or loops; remove the link, point it at a folder, or " + give;
           existing = existing.parent_path();
           if (existing.empty()) {
             existing = ".";

@@ -3,7 +3,10 @@
 #include <stdlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -20,10 +23,19 @@ namespace {
 class TemporaryFolder {
  public:
   TemporaryFolder() {
-    std::string name = (std::filesystem::temp_directory_path() / "hexbite-report-XXXXXX").string();
+    // TMPDIR naming a missing folder or a file gave the library's own text ("filesystem error:
+    // temp_directory_path: No such file or directory").
+    std::error_code ec;
+    const std::filesystem::path base = std::filesystem::temp_directory_path(ec);
+    const char* tmpdir = std::getenv("TMPDIR");
+    const std::string fix = "; point TMPDIR at a folder you can write to, or give --no-pictures";
+    if (ec)
+      throw RunError("cannot make a temporary folder for the report's pictures: TMPDIR is '" +
+                     std::string(tmpdir ? tmpdir : "") + "' (" + ec.message() + ")" + fix);
+    std::string name = (base / "hexbite-report-XXXXXX").string();
     if (mkdtemp(name.data()) == nullptr)
-      throw RunError("cannot create a temporary folder for the report's pictures in '" +
-                     std::filesystem::temp_directory_path().string() + "'");
+      throw RunError("cannot make a temporary folder for the report's pictures in '" + base.string() + "' (" +
+                     std::strerror(errno) + ")" + fix);
     path_ = name;
   }
   ~TemporaryFolder() {

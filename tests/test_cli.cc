@@ -344,6 +344,27 @@ TEST(CliBadInput, OutputPathsAreCheckedBeforeAnyWork) {
   }
   // No output and no temporary file.
   EXPECT_TRUE(fs::is_empty(dir));
+  // A dangling link as the output folder passed, and `run` and `study` failed after all their work (exit
+  // 1, "File exists"); the default landmark path of `generate` (a folder in the way, a name too long) was
+  // not checked at all until the mandible was made (helper K).
+  const std::string links = temp_dir();
+  fs::create_symlink(links + "/nowhere", links + "/dangling");
+  fs::create_directories(links + "/g.landmarks.yaml");
+  for (const Case& c : std::vector<Case>{
+           {{"run", "scenario.yaml", "-o", links + "/dangling"},
+            "'" + links + "/dangling' is a link to '" + links + "/nowhere', which does not exist"},
+           {{"study", "study.yaml", "-o", links + "/dangling/sub"}, "is a link to"},
+           {{"generate", "mandible", "-o", links + "/g.stl", "--dicom", links + "/dangling"}, "is a link to"},
+           {{"generate", "mandible", "-o", links + "/g.stl"},
+            "is a folder: give a file name in it, e.g. '" + links +
+                "/g.landmarks.yaml/out.yaml' (the landmark file's default name, from -o); give --landmarks "
+                "another path"},
+       }) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(links), fs::directory_iterator()), 2);
   // Any case of the extension is fine.
   EXPECT_EQ(run_hexbite({"surface", "check", cube, "-o", dir + "/copy.STL"}).exit_code, 0);
   // A name of 255 bytes is written (its temporary name, the name with ".tmpPID" added, used to be too long).

@@ -213,6 +213,19 @@ TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
             std::string::npos)
       << captions;
   EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
+
+  // TMPDIR naming a file gave the library's own text ("filesystem error: temp_directory_path: Not a
+  // directory"); now it is named, with what to do (helper K).
+  launcher = display_launcher();
+  launcher.insert(launcher.end(), {"env", "TMPDIR=" + dir + "/r.htm"});
+  const test::CommandResult bad = run_hexbite({"report", *run_dir_, "-o", dir + "/bad.html"}, launcher);
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_NE(bad.err.find("cannot make a temporary folder for the report's pictures: TMPDIR is '" + dir +
+                         "/r.htm' (Not a directory); point TMPDIR at a folder you can write to, or give "
+                         "--no-pictures"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_FALSE(fs::exists(dir + "/bad.html"));
 }
 
 // Supports that leave a rotation to the extent of their patches (as in tests/test_run.cc, on the cube): a
