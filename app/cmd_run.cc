@@ -85,21 +85,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output folder (created if missing)")
       ->required()
       ->check(output_folder());
-  // A set of formats: a repeated --export (a script adding it to a command line that has it) is no error.
-  cmd->add_option("--export", o->export_formats,
-                  "Also write the model for another solver: inp (CalculiX); may be repeated")
-      ->expected(1)
-      ->allow_extra_args(false)  // one format per --export: `--export inp SCENARIO` is not two formats
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->check(CLI::Validator(
-          [](std::string& format) -> std::string {
-            return format == "inp" ? std::string()
-                                   : "unknown format '" + format +
-                                         "': the one format is inp (CalculiX); the VTU files are written "
-                                         "unless the scenario says "
-                                         "outputs.vtu: false";
-          },
-          "inp"));
+  add_export_option(*cmd, o->export_formats);
   cmd->add_option(
          "--levels", o->levels,
          "Validation levels (each refines the mesh 8-way and solves again); overrides the scenario's "

@@ -1,4 +1,4 @@
-// hexbite study STUDY.yaml -o DIR [--levels N] [--json]
+// hexbite study STUDY.yaml -o DIR [--levels N] [--export inp] [--json]
 //
 // A what-if study as one command (docs/studies.md): every variant of the study's base scenario runs the
 // whole pipeline of `hexbite run` and gets its own run folder DIR/<variant>/, and DIR/study.json,
@@ -40,6 +40,7 @@ struct StudyCliOptions {
   std::string study;
   std::string output;
   std::optional<int> levels;
+  std::vector<std::string> export_formats;  // --export inp: every variant's model.inp
   bool json = false;
 };
 
@@ -100,6 +101,7 @@ void run_study(const StudyCliOptions& o) {
   for (std::size_t i = 0; i < count; ++i) {
     StudyVariant& v = study.variants[i];
     info("check variant " + counted(i));
+    if (!o.export_formats.empty()) v.scenario.outputs.inp = true;  // "inp", the one format
     for_variant(v, study.path, [&] {
       if (v.scenario.outputs.inp) check_inp_exportable(v.scenario);
       const int levels = o.levels ? *o.levels : v.scenario.mesh.validation_levels;
@@ -179,6 +181,8 @@ void add_study_command(CLI::App& app) {
                   "Validation levels of every variant (each refines the mesh 8-way and solves again); "
                   "overrides the scenarios' mesh.validation_levels")
       ->transform(count_in_range(0, 3));
+  // Asked for by users who wanted every variant's CalculiX deck: `--export inp` was "not expected".
+  add_export_option(*cmd, o->export_formats);
   cmd->add_flag("--json", o->json, "Print study.json instead of the table");
   cmd->callback([o] { run_study(*o); });
 }

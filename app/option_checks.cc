@@ -178,4 +178,22 @@ CLI::Validator output_folder() {
       "");
 }
 
+void add_export_option(CLI::App& command, std::vector<std::string>& formats) {
+  // A set of formats: a repeated --export (a script adding it to a command line that has it) is no error.
+  command
+      .add_option("--export", formats,
+                  "Also write the model for another solver: inp (CalculiX); may be repeated")
+      ->expected(1)
+      ->allow_extra_args(false)  // one format per --export: `--export inp SCENARIO` is not two formats
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::Validator(
+          [](std::string& format) -> std::string {
+            return format == "inp" ? std::string()
+                                   : "unknown format '" + format +
+                                         "': the one format is inp (CalculiX); the VTU files are written "
+                                         "unless the scenario says outputs.vtu: false";
+          },
+          "inp"));
+}
+
 }  // namespace hexbite

@@ -31,4 +31,7 @@ CLI::Validator output_hex_mesh_file();
 // An output folder: a folder or a path that does not exist yet (it is created), never an existing file.
 CLI::Validator output_folder();
 
+// `--export FORMAT` of run and study into `formats`: inp (CalculiX) is the one format; it may be repeated.
+void add_export_option(CLI::App& command, std::vector<std::string>& formats);
+
 }  // namespace hexbite

@@ -209,7 +209,9 @@ GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
         "geometry needs one of 'mandible', 'surface' or 'ct'; e.g. geometry: {mandible: {variant: dentate}}");
   if (given.size() > 1)
     fail(map.key_at(given[1]), "geometry has both " + quote(given[0]) + " and " + quote(given[1]) +
-                                   "; keep exactly one geometry source");
+                                   "; keep exactly one geometry source (in a study's set, replace the "
+                                   "whole geometry: geometry: {" +
+                                   given[1] + ": {...}}, not geometry." + given[1] + ")");
   if (map.has("mandible")) {
     g.source = GeometrySource::kMandible;
     std::vector<std::string> keys = {"variant"};

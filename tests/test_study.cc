@@ -227,6 +227,21 @@ TEST_F(CubeStudy, AReportListsAVariantsChangesInTheOrderTheyApply) {
             std::string::npos);
 }
 
+// `--export inp` writes every variant's CalculiX deck, as `run --export inp` does; it was "not expected",
+// and the way to get the decks (outputs.inp in every variant) was nowhere said (helper L).
+TEST(Study, ExportInpWritesEveryVariantsDeck) {
+  const std::string dir = study_folder(
+      "name: decks\nbase: base/cube.yaml\nvariants:\n  - name: a\n  - name: b\n"
+      "    set: {materials.default.E_MPa: 5500}\n");
+  const test::CommandResult r =
+      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out", "--export", "inp"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* variant : {"a", "b"})
+    for (const char* file : {"model.inp", "model_mesh.inp"})
+      EXPECT_TRUE(fs::exists(dir + "/out/" + variant + "/" + file)) << variant << " " << file;
+  EXPECT_NE(test::read_file(dir + "/out/b/model.inp").find("5500"), std::string::npos);
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
