@@ -105,7 +105,7 @@ void run_study(const StudyCliOptions& o) {
     for_variant(v, study.path, [&] {
       if (v.scenario.outputs.inp) check_inp_exportable(v.scenario);
       const int levels = o.levels ? *o.levels : v.scenario.mesh.validation_levels;
-      runs.push_back(prepare_run(v.scenario, levels));
+      runs.push_back(prepare_run(v.scenario, levels, /*in_study=*/true));
     });
   }
 

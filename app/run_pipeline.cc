@@ -284,7 +284,7 @@ constexpr double kBytesPerDof = 5e3;
 // DoFs at level 2): a last level whose solve needs more than this machine's memory (or the container's
 // cgroup limit, when lower), even shared by all ranks, is refused before the refinement, instead of ending
 // minutes later in bad_alloc or the kernel's out-of-memory kill.
-void require_levels_fit_memory(const Scenario& s, const HexMesh& coarse, int levels) {
+void require_levels_fit_memory(const Scenario& s, const HexMesh& coarse, int levels, bool in_study) {
   if (levels == 0) return;
   const double dofs = static_cast<double>(count_dofs(coarse, s.solver.degree)) * std::pow(8.0, levels);
   const double needed = kBytesPerDof * dofs / MpiSession::size();
@@ -295,16 +295,20 @@ void require_levels_fit_memory(const Scenario& s, const HexMesh& coarse, int lev
   if (levels == s.mesh.validation_levels)
     what = (s.mesh.validation_levels_at.line ? s.mesh.validation_levels_at.str() : s.path) +
            ": mesh.validation_levels" + (s.mesh.validation_levels_at.line ? " " : " (by default) ");
-  char text[800];
+  char text[1024];
   std::snprintf(
       text, sizeof text,
       "%d would solve level %d on %.0f hexes with about %.3g million degrees of freedom (degree %d), "
       "which needs about %.3g GB (%.0f kB per degree of freedom%s), more than the %.3g GB of %s; use fewer "
-      "levels, a smaller mesh.target_hexes%s, or mpirun on several machines",
+      "levels, a smaller mesh.target_hexes%s, or %s",
       levels, levels, static_cast<double>(coarse.hexes.size()) * std::pow(8.0, levels), dofs / 1e6,
       s.solver.degree, needed / 1e9, kBytesPerDof / 1e3,
       MpiSession::size() > 1 ? ", shared by the ranks" : "", memory.bytes / 1e9, memory.source.c_str(),
-      s.solver.degree > 1 ? " or solver.degree 1" : "");
+      s.solver.degree > 1 ? " or solver.degree 1" : "",
+      in_study
+          ? "run this variant's scenario alone with mpirun hexbite run on several machines (a study runs "
+            "in one process)"
+          : "mpirun on several machines");
   throw InputError(what + text);
 }
 
@@ -851,7 +855,7 @@ std::vector<std::pair<int, Vec3>> consistent_nodal_forces(const HexMesh& mesh,
   return {forces.begin(), forces.end()};
 }
 
-RunResult prepare_run(Scenario scenario, int levels) {
+RunResult prepare_run(Scenario scenario, int levels, bool in_study) {
   const auto start = std::chrono::steady_clock::now();
   RunResult result;
   Geometry geometry;
@@ -884,7 +888,7 @@ RunResult prepare_run(Scenario scenario, int levels) {
   }
   require_fixed_supports_apart(scenario, result.levels.back());
   require_muscles_load_the_bone(scenario, result.levels.back());
-  require_levels_fit_memory(scenario, coarse, levels);
+  require_levels_fit_memory(scenario, coarse, levels, in_study);
 
   // Every patch of every level is selected before the first solve, so a scenario error never costs a solve.
   std::unique_ptr<SurfaceProjector> projector;

@@ -77,7 +77,9 @@ RunResult run_pipeline(Scenario scenario, int levels);
 // app/cmd_study.cc): prepare_run() does everything but the solves (geometry, points, meshes and patches of
 // every level, and every check that needs them), so its InputErrors come before any solve; its result has
 // no solutions yet. solve_run() then solves every level. seconds_total adds up the time of both.
-RunResult prepare_run(Scenario scenario, int levels);
+// `in_study`: the scenario is a study's variant, which runs in one process: advice to use mpirun names
+// `hexbite run` of the variant's scenario.
+RunResult prepare_run(Scenario scenario, int levels, bool in_study = false);
 void solve_run(RunResult& result);
 
 // The checks of a solved run that no scenario check can make in advance: applied forces and reactions

@@ -186,7 +186,8 @@ Study load_study(const std::string& path) {
   const Map map({&study_source, root, top, ""}, {"name", "description", "base", "variants"}, "the study");
   Study study;
   study.path = path;
-  study.name = to_string(map.require("name", "name: atrophy what-if"));
+  study.name =
+      to_string(map.require("name", "name: atrophy what-if"), "write a name such as 'atrophy what-if'");
   if (auto x = map.find("description"))
     study.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x, kTextHint);
 
@@ -214,7 +215,7 @@ Study load_study(const std::string& path) {
     StudyVariant variant;
     variant.where = item.at;
     const Value& name = v.require("name", "name: soft_bone");
-    variant.name = to_string(name);
+    variant.name = to_string(name, "write a name such as soft_bone (it names the variant's output folder)");
     check_variant_name(variant.name, name.at);
     for (const StudyVariant& earlier : study.variants)
       if (earlier.name == variant.name)

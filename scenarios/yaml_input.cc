@@ -60,8 +60,9 @@ std::string describe(const YAML::Node& node) {
 }
 
 std::string to_string(const Value& v, const std::string& hint) {
-  if (!v.node.IsScalar() || v.node.Scalar().empty())
-    fail(v.at, v.path + " must be text, found " + describe(v.node) + "; " + hint);
+  // `name: ""` read "must be text, found the quoted text """, which is text.
+  if (v.node.IsScalar() && v.node.Scalar().empty()) fail(v.at, v.path + " is empty; " + hint);
+  if (!v.node.IsScalar()) fail(v.at, v.path + " must be text, found " + describe(v.node) + "; " + hint);
   return v.node.Scalar();
 }
 

@@ -242,6 +242,21 @@ TEST(Study, ExportInpWritesEveryVariantsDeck) {
   EXPECT_NE(test::read_file(dir + "/out/b/model.inp").find("5500"), std::string::npos);
 }
 
+// Levels beyond the machine's memory were told to use "mpirun on several machines", which a study refuses.
+TEST(Study, LevelsBeyondTheMemoryAdviseRunningTheVariantAlone) {
+  const std::string dir = study_folder(
+      "name: deep\nbase: base/cube.yaml\nvariants:\n  - name: q2\n    set: {mesh.target_hexes: 4000, "
+      "mesh.validation_levels: 3, solver: {degree: 2}}\n");
+  const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(
+      r.err.find("run this variant's scenario alone with mpirun hexbite run on several machines (a study "
+                 "runs in one process)"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
@@ -402,6 +417,10 @@ TEST(Study, UnknownKeyAndUnsafeVariantNameAreRefused) {
   std::string study = kStudy;
   study.replace(study.find("name: no_bite"), 13, "name: ../up");
   expect_refused(study, 8, "variant name '../up' is not a safe folder name");
+  // An empty name was "must be text, found the quoted text \"\"; write a word such as left_condyle".
+  study = kStudy;
+  study.replace(study.find("name: no_bite"), 13, "name: \"\"");
+  expect_refused(study, 8, "variants[2].name is empty; write a name such as soft_bone");
 }
 
 // Values the study set are named at the study's line and resolve paths from its folder; the rest of the
