@@ -94,7 +94,14 @@ std::string study_changes(const json& set, bool abbreviate) {
     std::string text = value.is_string() ? value.get<std::string>()
                                          : value.dump(-1, ' ', false, json::error_handler_t::replace);
     if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
-    out += (out.empty() ? "" : "; ") + path + ": " + text;
+    // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell.
+    std::string line;
+    for (char c : text) {
+      if (c == '\n' || c == '\r') c = ' ';
+      if (c != ' ' || (!line.empty() && line.back() != ' ')) line += c;
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += (out.empty() ? "" : "; ") + path + ": " + line;
   }
   return out;
 }

@@ -317,6 +317,15 @@ TEST(StudyTable, ALineBreakInAChangeStaysInItsRow) {
   const std::string md = study_markdown(study);
   EXPECT_EQ(std::count(md.begin(), md.end(), '\n'), 3) << md;  // header, rule, one row
   EXPECT_NE(md.find("two lines"), std::string::npos) << md;
+  // The CSV's set cell is on one line too (studies.md); it kept the break, quoted (helper L).
+  StudyTable table;
+  StudyRow row;
+  row.name = "a";
+  row.set = {{"description", "two\nlines\n"}};
+  table.rows.push_back(row);
+  const std::string csv = study_csv(study_json(table));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;  // header, one row
+  EXPECT_NE(csv.find(",description: two lines,"), std::string::npos) << csv;
 }
 
 TEST(Study, UnknownKeyOnThePathIsRefusedWithTheKeysThere) {
