@@ -796,9 +796,12 @@ void solve_level(const Scenario& s, LevelResult& r) {
       std::snprintf(settings, sizeof settings,
                     "; the scenario's solver.max_iterations is %d, solver.tolerance %g",
                     s.solver.max_iterations, s.solver.tolerance);
-      throw RunError((s.solver.where.line ? s.solver.where.str() : s.path) + ": level " +
-                     std::to_string(r.level) + " (" + std::to_string(dofs) +
-                     " degrees of freedom): " + e.what() + settings);
+      // At the setting that ends the iterations when one was written (a study's own line), else the
+      // `solver` mapping.
+      const SourceLocation& at =
+          s.solver.max_iterations_at.line ? s.solver.max_iterations_at : s.solver.where;
+      throw RunError((at.line ? at.str() : s.path) + ": level " + std::to_string(r.level) + " (" +
+                     std::to_string(dofs) + " degrees of freedom): " + e.what() + settings);
     }
     progress.finish(std::to_string(r.solution.dofs) + " DoFs");
     // The reactions in the scenario's order, the released contacts' zero.
@@ -953,10 +956,13 @@ void require_trustworthy(const RunResult& result, const std::string& results) {
       std::snprintf(text, sizeof text, "relative residual %.3g > 1e-8", l.solution.equilibrium_residual);
       char tolerance[32];
       std::snprintf(tolerance, sizeof tolerance, "%g", solver.tolerance);
-      throw RunError(
-          "level " + std::to_string(l.level) + ": applied forces and reactions do not balance (" + text +
-          "); " + results + " are not trustworthy: tighten solver.tolerance (" + tolerance +
-          (solver.where.line ? ", solver at " + solver.where.str() : std::string(", the default")) + ")");
+      // The place first, as every scenario message has it: inside the parentheses a study's note ("variant
+      // 'tol' of study cg.yaml") read as part of the value.
+      const SourceLocation& at = solver.tolerance_at.line ? solver.tolerance_at : solver.where;
+      throw RunError((at.line ? at.str() + ": " : std::string()) + "level " + std::to_string(l.level) +
+                     ": applied forces and reactions do not balance (" + text + "); " + results +
+                     " are not trustworthy: tighten solver.tolerance (" + tolerance +
+                     (at.line ? std::string() : std::string(", the default")) + ")");
     }
     if (l.solution.max_displacement > kMaxDisplacementFraction * size) {
       char text[400];

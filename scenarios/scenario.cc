@@ -609,12 +609,14 @@ SolverSpec parse_solver(const Value& v) {
                                                          {"cg_amg", LinearSolverChoice::kCgAmg},
                                                          {"direct", LinearSolverChoice::kDirect}});
   if (auto x = map.find("tolerance")) {
+    s.tolerance_at = x->at;
     s.tolerance = to_number(*x);
     if (s.tolerance <= 0 || s.tolerance >= 1)
       fail(x->at, "solver.tolerance is " + fmt(s.tolerance) +
                       " but a relative tolerance must lie in (0, 1); the default is 1e-10");
   }
   if (auto x = map.find("max_iterations")) {
+    s.max_iterations_at = x->at;
     const long long n = to_whole(*x);
     if (n <= 0 || n > std::numeric_limits<int>::max())
       fail(x->at, "solver.max_iterations is " + std::to_string(n) + " but must be from 1 to " +

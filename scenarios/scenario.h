@@ -152,6 +152,9 @@ struct SolverSpec {
   double tolerance = 1e-10;  // relative residual
   int max_iterations = 10000;
   SourceLocation where;  // where the `solver` mapping was written (empty: all defaults)
+  // Where tolerance and max_iterations were written (empty: defaults). A study that sets one is named at
+  // its own line; a failed solve named the base's `solver` line.
+  SourceLocation tolerance_at, max_iterations_at;
 };
 
 struct Outputs {

@@ -257,6 +257,21 @@ TEST(Study, LevelsBeyondTheMemoryAdviseRunningTheVariantAlone) {
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
+// A run that fails for a setting the study made was named at the base's `solver` line, with the study's
+// note inside the parentheses of the value (helper L).
+TEST(Study, ARunThatFailsForTheStudysSettingNamesTheStudysLine) {
+  // On the shipped lateral bite: the cube of these tests converges in one iteration whatever the tolerance.
+  const std::string dir =
+      study_folder("name: cg\nbase: " + std::string(HEXBITE_SOURCE_DIR) +
+                   "/scenarios/lateral_bite_hard_nut.yaml\nvariants:\n  - name: loose\n    "
+                   "set:\n      solver.tolerance: 0.5\n      solver.linear_solver: cg_amg\n");
+  const test::CommandResult r =
+      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out", "--levels", "0"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:6:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("tighten solver.tolerance (0.5)"), std::string::npos) << r.err;
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
