@@ -559,7 +559,9 @@ Support parse_support(const Value& item) {
   const Map map(item, {"name", "at", "radius_mm", "fixed", "spring_N_per_mm3", "bite", "contact"});
   Support s;
   s.where = item.at;
-  s.name = to_string(map.require("name", "name: right_condyle"));
+  const Value& name = map.require("name", "name: right_condyle");
+  s.name = to_string(name);
+  s.name_at = name.at;
   s.at = to_point(map.require("at", "at: right_condyle_tmj_point"));
   s.radius_mm =
       patch_radius(map.require("radius_mm", "radius_mm: 5"), "the support patch radius in mm, e.g. 5");
@@ -642,8 +644,9 @@ void check_unique_names(const std::vector<T>& items, const std::string& kind) {
       if (items[i].name != items[j].name) continue;
       // The list order is not the file's: the muscles of an activation_pattern come after the muscles
       // list, wherever the pattern is written. The message names the later place and the earlier line.
-      const SourceLocation* first = &items[j].where;
-      const SourceLocation* second = &items[i].where;
+      // At each name's own place when it has one (a study's rename), else at the item.
+      const SourceLocation* first = items[j].name_at.line ? &items[j].name_at : &items[j].where;
+      const SourceLocation* second = items[i].name_at.line ? &items[i].name_at : &items[i].where;
       if (first->file == second->file &&
           std::tie(second->line, second->column) < std::tie(first->line, first->column))
         std::swap(first, second);
@@ -766,8 +769,8 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
   if (auto x = root.find("probes"))
     for (const Value& item : to_list(*x)) {
       const Map p(item, {"name", "at"});
-      s.probes.push_back({to_string(p.require("name", "name: chin")),
-                          to_point(p.require("at", "at: incisal_point")), item.at});
+      const Value& name = p.require("name", "name: chin");
+      s.probes.push_back({to_string(name), to_point(p.require("at", "at: incisal_point")), item.at, name.at});
     }
   check_poisson_for_degree(s);
   check_unique_names(s.muscles, "muscle");

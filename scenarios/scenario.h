@@ -128,6 +128,7 @@ struct Muscle {
   double activation = 0;
   Vec3 line_of_action{};  // unit vector, filled in by resolve_points()
   SourceLocation where;
+  SourceLocation name_at;   // where the name was written when not at `where` (empty: at where)
   std::string pattern_key;  // the activation_pattern key it came from ("superficial_masseter"), or empty
 };
 
@@ -142,6 +143,9 @@ struct Support {
   // whose reaction would pull is released and the level solved again without it (run_pipeline.h).
   bool contact = false;
   SourceLocation where;
+  // Where the name was written: a study that renames the support (supports.x.name) wrote it in the study
+  // file, and a clash of names is named there.
+  SourceLocation name_at;
 };
 
 enum class LinearSolverChoice { kAuto, kCgAmg, kDirect };
@@ -167,6 +171,7 @@ struct Probe {
   std::string name;
   PointRef at;
   SourceLocation where;
+  SourceLocation name_at;  // as Support::name_at
 };
 
 struct Scenario {

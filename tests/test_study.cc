@@ -272,6 +272,21 @@ TEST(Study, ARunThatFailsForTheStudysSettingNamesTheStudysLine) {
   EXPECT_NE(r.err.find("tighten solver.tolerance (0.5)"), std::string::npos) << r.err;
 }
 
+// A study that renames an item onto another's name was named at the base's line, where the item still had
+// its old name (helper L).
+TEST(Study, ARenameOntoAnotherNameIsNamedAtTheStudysLine) {
+  std::string study = kStudy;
+  study.replace(study.find("materials.default.E_MPa: 5500"), 29, "probes.b.name: a");
+  const std::string dir = study_folder(study);
+  std::string scenario = test::read_file(dir + "/base/cube.yaml");
+  scenario += "probes:\n  - {name: a, at: [10, 10, 10]}\n  - {name: b, at: [12, 10, 10]}\n";
+  test::write_file(dir + "/base/cube.yaml", scenario);
+  const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("probe 'a' is defined twice (first on line"), std::string::npos) << r.err;
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
