@@ -91,7 +91,7 @@ std::string phase_table(const OptimizeReport& r) {
 // The frame of the kept grid: the swept core's is the arch's (--core auto may keep it with --grid-frame
 // axes).
 std::string grid_frame_used(const MeshOptions& o, const GridMeshReport& r) {
-  return r.swept ? "arch" : o.grid_frame;
+  return r.swept ? "arch" : r.principal_frame ? "principal" : o.grid_frame;
 }
 
 // --core auto's line: which core it kept, and why when not simply the swept one.
@@ -105,15 +105,19 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   std::ostringstream out;
   const MeshFidelity& f = r.fidelity;
   out << "Meshed " << o.surface << " (grid + pillow"
-      << (grid_frame_used(o, r) == "arch" ? ", along the arch" : "") << (r.swept ? ", swept core" : "")
-      << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes << " core + " << r.pillow_hexes
-      << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target << "\n";
+      << (grid_frame_used(o, r) == "arch"        ? ", along the arch"
+          : grid_frame_used(o, r) == "principal" ? ", along the principal axes"
+                                                 : "")
+      << (r.swept ? ", swept core" : "") << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes
+      << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
+      << "\n";
   out << "cell size " << fmt("%.3f", r.cell_size) << " mm, grid " << r.grid[0] << " x " << r.grid[1] << " x "
       << r.grid[2] << (r.swept ? " (along the arch x layers across x up)" : "") << ", "
       << (r.swept ? std::to_string(r.cells_in_dropped_components) + " columns dropped for a manifold core"
                   : std::to_string(r.cells_added_for_manifold) + " cells added for a manifold core")
       << (r.attempts > 1 ? ", the best of " + std::to_string(r.attempts) + " grids" : std::string()) << "\n";
   if (choice) out << auto_core_line(*choice) << '\n';
+  if (r.principal_retry) out << principal_retry_text(*r.principal_retry) << '\n';
   out << '\n' << phase_table(r.optimize) << '\n';
   out << "optimizer: " << r.optimize.untangle_sweeps << " untangling sweeps, " << r.optimize.iterations
       << " Newton sweeps in " << r.optimize.rounds << " rounds; sum of squared condition numbers "
@@ -152,6 +156,11 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
   j["grid_attempts"] = r.attempts;
   j["grid_frame"] = grid_frame_used(o, r);
+  j["principal_retry"] = r.principal_retry
+                             ? nlohmann::json{{"axes_inverted", r.principal_retry->axes_inverted},
+                                              {"principal_inverted", r.principal_retry->principal_inverted},
+                                              {"kept", r.principal_retry->kept}}
+                             : nlohmann::json();
   j["core"] = r.swept ? "swept" : "grid";
   j["core_requested"] = o.core;
   if (choice) j["core_reason"] = choice->reason;

@@ -166,6 +166,7 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
       throw InputError(s.mesh.core_at.str() + ": mesh.core swept: " + e.what());
     throw InputError(s.mesh.grid_frame_at.str() + ": mesh.grid_frame arch: " + e.what());
   }
+  if (report.principal_retry) info("mesh: " + principal_retry_text(*report.principal_retry));
   if (report.volume_fit) info_volume_fit(*report.volume_fit, report.fidelity);
   name_unresolved_parts(geometry.landmarks, report.fidelity.unresolved);
   *fidelity = report.fidelity;
@@ -694,7 +695,7 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
         "the supports hold the bone only weakly against a rotation about the axis through " +
         format_point(m.axis_point) + " mm along " + format_point(m.direction, 2) +
         ": only the extent of their patches resists it";
-    char hold[256];
+    char hold[512];
     std::snprintf(hold, sizeof hold,
                   " (hold %.2g, below %.2g; the shipped scenarios 0.33 to 1.28), so the displacements and "
                   "stresses depend mostly on how the patches resist that rotation. A body clamped at one end "

@@ -21,6 +21,7 @@
 #include "mesher/cell_size_search.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/hex_quality_kernel.h"
+#include "mesher/principal_frame.h"
 #include "mesher/surface_projector.h"
 #include "mesher/swept_core.h"
 #include "mesher/union_find.h"
@@ -1134,12 +1135,25 @@ enum class CoreRule {
   kSweptNewton,
 };
 
+// The frame the core is selected in: the body's own axes, the dental arch, or the principal axes.
+struct CoreFrame {
+  const ArchFrame* arch = nullptr;
+  const PrincipalFrame* principal = nullptr;
+  bool body() const { return arch == nullptr && principal == nullptr; }
+  Vec3 to_grid(const Vec3& v) const {
+    return arch ? arch->to_arch(v) : principal ? principal->to_frame(v) : v;
+  }
+  Vec3 to_body(const Vec3& v) const {
+    return arch ? arch->to_body(v) : principal ? principal->to_body(v) : v;
+  }
+};
+
 // Steps 1 and 2 of one grid, shifted by `shift` cells: the cell size and the core (`mesh` holds the core).
-// With an arch frame, `projector` and `shells` are those of the straightened surface (arch coordinates), and
-// the core's vertices are mapped back to the body.
+// In another frame than the body's, `projector` and `shells` are those of the surface in that frame (arch
+// coordinates, or the principal axes), and the core's vertices are mapped back to the body.
 GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, const Vec3& lo, const Vec3& hi,
                       double volume, double mean_thickness, const GridMeshOptions& options, double shift,
-                      CoreRule rule, const ArchFrame* arch) {
+                      CoreRule rule, const CoreFrame& frame) {
   const auto t_attempt = std::chrono::steady_clock::now();
   GridAttempt out;
   GridMeshReport& r = out.report;
@@ -1189,8 +1203,8 @@ GridAttempt grid_core(const SurfaceProjector& projector, const Shells& shells, c
   for (const MissedBody& m : best.missed) r.cells_in_dropped_components += m.cells;
   std::tie(r.core_boundary_vertices, r.irregular_core_boundary_vertices) = boundary_valences(best);
   out.mesh = core_mesh(best);
-  if (arch)
-    for (Vec3& v : out.mesh.vertices) v = arch->to_body(v);
+  if (!frame.body())
+    for (Vec3& v : out.mesh.vertices) v = frame.to_body(v);
   r.core_hexes = int(out.mesh.hexes.size());
   r.seconds_core = seconds_since(t_attempt);
   return out;
@@ -1282,7 +1296,9 @@ double worst_element_measure(const QualitySummary& q) {
   return std::min(q.scaled_jacobian.min, 3.0 / q.condition.max);
 }
 
-HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
+// grid_mesh in one frame (the coordinate axes, the arch or the principal axes).
+static HexMesh grid_mesh_in_frame(const TriSurface& surface, const GridMeshOptions& options,
+                                  GridMeshReport* report_out) {
   if (options.target_hexes < 8)
     throw InputError("grid mesher: the target hex count must be at least 8, got " +
                      std::to_string(options.target_hexes));
@@ -1292,8 +1308,9 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   const double volume = enclosed_volume(surface);
   if (!(volume > 0))
     throw InputError("grid mesher: the surface encloses no volume (is it oriented outward?)");
-  // With the arch frame the core is selected on the straightened surface (arch coordinates) and its
-  // vertices mapped back; the pillow layer, the optimization and the fidelity work on the surface itself.
+  // With the arch frame (or the principal axes) the core is selected on the straightened (rotated) surface
+  // and its vertices mapped back; the pillow layer, the optimization and the fidelity work on the surface
+  // itself.
   std::optional<ArchFrame> arch;
   TriSurface straightened;
   std::unique_ptr<SurfaceProjector> straightened_projector;
@@ -1307,17 +1324,24 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
                            "the swept core lies along the arch: use the grid core for other solids (--core "
                            "grid --grid-frame axes, in a scenario core: grid and grid_frame: axes)");
     }
+  }
+  std::optional<PrincipalFrame> principal;
+  if (!arch && options.principal_frame) principal = principal_frame(surface);
+  CoreFrame frame;
+  frame.arch = arch ? &*arch : nullptr;
+  frame.principal = principal ? &*principal : nullptr;
+  if (!frame.body()) {
     straightened = surface;
-    for (Vec3& v : straightened.vertices) v = arch->to_arch(v);
+    for (Vec3& v : straightened.vertices) v = frame.to_grid(v);
     straightened_projector = std::make_unique<SurfaceProjector>(straightened);
   }
-  const TriSurface& grid_surface = arch ? straightened : surface;
-  const SurfaceProjector& grid_projector = arch ? *straightened_projector : projector;
+  const bool framed = !frame.body();
+  const TriSurface& grid_surface = framed ? straightened : surface;
+  const SurfaceProjector& grid_projector = framed ? *straightened_projector : projector;
   std::optional<Shells> straightened_shells;
-  if (arch) straightened_shells = find_shells(straightened);
-  const Shells& grid_shells = arch ? *straightened_shells : shells;
-  const double grid_volume = arch ? enclosed_volume(straightened) : volume;
-  const ArchFrame* arch_frame = arch ? &*arch : nullptr;
+  if (framed) straightened_shells = find_shells(straightened);
+  const Shells& grid_shells = framed ? *straightened_shells : shells;
+  const double grid_volume = framed ? enclosed_volume(straightened) : volume;
   double area = 0;
   for (const auto& t : grid_surface.triangles)
     area += 0.5 * norm(cross(sub(grid_surface.vertices[t[1]], grid_surface.vertices[t[0]]),
@@ -1389,7 +1413,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
         attempts[a] = swept_attempt(grid_projector, lo, hi, options, jobs[a].shift, *arch);
       else if (a > 0)
         attempts[a] = grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness, options,
-                                jobs[a].shift, jobs[a].rule, arch_frame);
+                                jobs[a].shift, jobs[a].rule, frame);
       const CoreRule rule = jobs[a].rule;
       pillow_and_optimize(attempts[a], projector,
                           rule == CoreRule::kSwept         ? per_swept
@@ -1418,7 +1442,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
     try {
       attempts[0] = swept ? swept_attempt(grid_projector, lo, hi, options, shifts[0], *arch)
                           : grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness,
-                                      options, shifts[0], jobs[0].rule, arch_frame);
+                                      options, shifts[0], jobs[0].rule, frame);
       decide_jobs(attempts[0].fine);
       run_job(0);
     } catch (...) {
@@ -1518,7 +1542,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   report.fidelity = measure_fidelity(mesh, projector);
   if (kept.dropped > 0) {
     UnresolvedPart part;
-    part.location = arch ? arch->to_body(kept.dropped_centroid) : kept.dropped_centroid;
+    part.location = frame.to_body(kept.dropped_centroid);
     part.samples = kept.dropped;
     part.what =
         std::to_string(kept.dropped) + " grid cells around " + format_point_mm(part.location) +
@@ -1530,7 +1554,7 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   cell << std::fixed << kept.grid.h;
   for (auto j = kept.joined.rbegin(); j != kept.joined.rend(); ++j) {
     UnresolvedPart part;
-    part.location = arch ? arch->to_body(j->contact) : j->contact;
+    part.location = frame.to_body(j->contact);
     std::string around;
     for (int b : j->bodies)
       around += (around.empty()          ? ""
@@ -1574,6 +1598,40 @@ HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, Gri
   }
   report.seconds_fidelity = seconds_since(t0);
   report.seconds_total = seconds_since(t_start);
+  report.principal_frame = principal.has_value();
+  if (report_out) *report_out = std::move(report);
+  return mesh;
+}
+
+std::string principal_retry_text(const PrincipalRetry& retry) {
+  return "the grids along the coordinate axes left " + std::to_string(retry.axes_inverted) +
+         " inverted hexes; along the solid's principal axes " + std::to_string(retry.principal_inverted) +
+         ": kept " + (retry.kept ? "those" : "the first");
+}
+
+HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
+  GridMeshReport report;
+  HexMesh mesh = grid_mesh_in_frame(surface, options, &report);
+  const bool retry = options.principal_retry && !options.principal_frame && !options.arch_frame &&
+                     !options.swept_core && report.optimize.inverted > 0;
+  const std::optional<PrincipalFrame> principal = retry ? principal_frame(surface) : std::nullopt;
+  if (principal && !principal->along_coordinate_axes()) {
+    GridMeshOptions along = options;
+    along.principal_frame = true;
+    GridMeshReport other;
+    HexMesh other_mesh = grid_mesh_in_frame(surface, along, &other);
+    PrincipalRetry tried{report.optimize.inverted, other.optimize.inverted,
+                         other.optimize.inverted < report.optimize.inverted};
+    const double seconds = report.seconds_total + other.seconds_total;
+    const int attempts = report.attempts + other.attempts;
+    if (tried.kept) {
+      mesh = std::move(other_mesh);
+      report = std::move(other);
+    }
+    report.principal_retry = tried;
+    report.seconds_total = seconds;
+    report.attempts = attempts;
+  }
   if (report_out) *report_out = std::move(report);
   return mesh;
 }

@@ -113,6 +113,12 @@ struct GridMeshOptions {
   // mapped back before the pillow layer) instead of along the axes; for a whole mandible in the mandible
   // frame (throws NotAnArchError, an InputError, for a surface that does not follow an arch).
   bool arch_frame = false;
+  // Lay the grid along the solid's principal axes (mesher/principal_frame.h) instead of the coordinate
+  // axes. When principal_retry is on and the axes' grids leave inverted hexes (a solid with flat faces at an
+  // angle to the axes), the principal axes' grids are meshed too and the mesh with fewer inverted hexes is
+  // kept (report.principal_retry). Neither applies with arch_frame or swept_core.
+  bool principal_frame = false;
+  bool principal_retry = true;
   // The core swept across the dental arch (mesher/swept_core.h) instead of the grid cores: a grid over the
   // bone's side view with swept_layers hexes across the bone in each column, unshifted and shifted by half
   // a cell (two attempts, the better kept as in step 5). Implies arch_frame. Meant for coarse meshes: with
@@ -198,11 +204,24 @@ struct MeshFidelity {
   std::vector<UnresolvedPart> unresolved;  // surface regions farther than half the mean edge length
 };
 
+// The principal axes' grids meshed after the axes' grids left inverted hexes (GridMeshOptions).
+struct PrincipalRetry {
+  int axes_inverted = 0;       // inverted hexes of the axes' best grid
+  int principal_inverted = 0;  // and of the principal axes' best grid
+  bool kept = false;           // the principal axes' mesh was kept (it had fewer)
+};
+
+// "the grids along the coordinate axes left 2 inverted hexes; along the solid's principal axes 0: kept
+// those", for `mesh` and `run`.
+std::string principal_retry_text(const PrincipalRetry& retry);
+
 struct GridMeshReport {
   // Grids tried (GridMeshOptions::grids; with fine cells 4, or 6 with the mean or the defect retry).
   int attempts = 1;
-  double cell_size = 0;       // h, mm (this and the fields below describe the kept grid)
-  std::array<int, 3> grid{};  // grid cells per axis
+  bool principal_frame = false;                   // the kept grid lies along the principal axes
+  std::optional<PrincipalRetry> principal_retry;  // when it was tried
+  double cell_size = 0;                           // h, mm (this and the fields below describe the kept grid)
+  std::array<int, 3> grid{};                      // grid cells per axis
   int core_hexes = 0;
   int pillow_hexes = 0;
   bool swept = false;  // the kept core is the swept core (grid: cells along s, layers across, cells along z)

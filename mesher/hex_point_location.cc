@@ -27,6 +27,19 @@ double shape_derivative(int k, const Vec3& u, int along) {
   return value;
 }
 
+// The derivative of hex h's map at u: column k is dx/du_k.
+Eigen::Matrix3d jacobian_at(const HexMesh& mesh, int h, const Vec3& u) {
+  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < 8; ++k) {
+    const Vec3& v = mesh.vertices[mesh.hexes[h][k]];
+    for (int along = 0; along < 3; ++along) {
+      const double d = shape_derivative(k, u, along);
+      for (int a = 0; a < 3; ++a) jacobian(a, along) += d * v[a];
+    }
+  }
+  return jacobian;
+}
+
 }  // namespace
 
 Vec3 trilinear_point(const HexMesh& mesh, int h, const Vec3& unit) {
@@ -50,15 +63,7 @@ std::optional<Vec3> trilinear_unit(const HexMesh& mesh, int h, const Vec3& point
     const Vec3 x = trilinear_point(mesh, h, u);
     const Eigen::Vector3d residual(point[0] - x[0], point[1] - x[1], point[2] - x[2]);
     if (residual.norm() <= 1e-12 * (1.0 + size)) return u;
-    Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
-    for (int k = 0; k < 8; ++k) {
-      const Vec3& v = mesh.vertices[mesh.hexes[h][k]];
-      for (int along = 0; along < 3; ++along) {
-        const double d = shape_derivative(k, u, along);
-        for (int a = 0; a < 3; ++a) jacobian(a, along) += d * v[a];
-      }
-    }
-    const Eigen::FullPivLU<Eigen::Matrix3d> lu(jacobian);
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(jacobian_at(mesh, h, u));
     if (!lu.isInvertible()) return std::nullopt;
     const Eigen::Vector3d step = lu.solve(residual);
     for (int a = 0; a < 3; ++a) u[a] += step[a];
@@ -95,14 +100,7 @@ PointInHex nearest_point_inside(const HexMesh& mesh, const std::vector<int>& hex
     // nearer: on a curved face the clamped inverse is not the nearest point.
     Vec3 unit = clamp(*u), x = trilinear_point(mesh, h, unit);
     for (int iteration = 0; iteration < 20; ++iteration) {
-      Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();
-      for (int k = 0; k < 8; ++k) {
-        const Vec3& v = mesh.vertices[mesh.hexes[h][k]];
-        for (int along = 0; along < 3; ++along) {
-          const double d = shape_derivative(k, unit, along);
-          for (int a = 0; a < 3; ++a) jacobian(a, along) += d * v[a];
-        }
-      }
+      const Eigen::Matrix3d jacobian = jacobian_at(mesh, h, unit);
       const Eigen::Vector3d residual(point[0] - x[0], point[1] - x[1], point[2] - x[2]);
       // Steps only along the unit directions not held at a bound by the residual.
       const Eigen::Vector3d gradient = jacobian.transpose() * residual;
