@@ -161,9 +161,12 @@ void run_study(const StudyCliOptions& o) {
                 << " s in all)\n";
     }
   } catch (const InputError& e) {
-    throw InputError(std::string(e.what()) + "; the study kept none of its files and " + left);
+    throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) +
+                     "; the study kept none of its files and " + left);
   } catch (const RunError& e) {
-    throw RunError(std::string(e.what()) + "; the study kept none of its files and " + left);
+    // A variant's files are written into the study's hidden stage: named where the user looks for them.
+    throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) +
+                   "; the study kept none of its files and " + left);
   }
 }
 
