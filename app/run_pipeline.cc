@@ -695,14 +695,13 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
         "the supports hold the bone only weakly against a rotation about the axis through " +
         format_point(m.axis_point) + " mm along " + format_point(m.direction, 2) +
         ": only the extent of their patches resists it";
-    char hold[512];
-    std::snprintf(hold, sizeof hold,
-                  " (hold %.2g, below %.2g; the shipped scenarios 0.33 to 1.28), so the displacements and "
-                  "stresses depend mostly on how the patches resist that rotation. A body clamped at one end "
-                  "(a cantilever) is held so by design; otherwise fix more components of a support, or add a "
-                  "support away from that axis",
-                  m.rho, kWeakSupportHold);
-    warn(s.supports.front().where.str() + ": " + context + text + motion + hold);
+    // Numbers into a small buffer, the sentence as a string (a fixed buffer cut it when it grew).
+    char values[64];
+    std::snprintf(values, sizeof values, "hold %.2g, below %.2g", m.rho, kWeakSupportHold);
+    warn(s.supports.front().where.str() + ": " + context + text + motion + " (" + values +
+         "; the shipped scenarios 0.33 to 1.28), so the displacements and stresses depend mostly on how the "
+         "patches resist that rotation. A body clamped at one end (a cantilever) is held so by design; "
+         "otherwise fix more components of a support, or add a support away from that axis");
   }
   return modes;
 }
