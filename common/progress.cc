@@ -1,11 +1,13 @@
 #include "common/progress.h"
 
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
 
 namespace hexbite {
 
@@ -90,9 +92,17 @@ void Progress::draw(double fraction, const std::string& note, bool final_line) {
   const int filled = static_cast<int>(fraction * kWidth + 0.5);
   std::string bar(filled, '#');
   bar.append(kWidth - filled, ' ');
-  std::fprintf(stderr, "\r\033[K%-28s [%s] %3d%%  %6.1f s  %s", label_.c_str(), bar.c_str(),
-               static_cast<int>(fraction * 100 + 0.5), seconds(), note.c_str());
-  if (final_line) std::fputc('\n', stderr);
+  char text[512];
+  std::snprintf(text, sizeof text, "%-28s [%s] %3d%%  %6.1f s  %s", label_.c_str(), bar.c_str(),
+                static_cast<int>(fraction * 100 + 0.5), seconds(), note.c_str());
+  std::string line = text;
+  // A line that is redrawn must fit the terminal: one that wraps is cleared only in its last row by
+  // "\r\033[K", and on a narrow terminal every redraw left a row behind (helper K, 50 columns).
+  winsize size{};
+  if (!final_line && ::ioctl(STDERR_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 1 &&
+      line.size() >= size.ws_col)
+    line.resize(size.ws_col - 1);
+  std::fprintf(stderr, "\r\033[K%s%s", line.c_str(), final_line ? "\n" : "");
   std::fflush(stderr);
 }
 

@@ -567,6 +567,28 @@ TEST(Cli, AFailedStepDoesNotShowAFullProgressBar) {
   EXPECT_NE(good.find("100%"), std::string::npos) << good;
 }
 
+// A progress line that is redrawn wraps on a narrow terminal, and "\r\033[K" clears only its last row: every
+// redraw left a row behind (helper K, 50 columns). Redrawn lines are cut to the terminal's width; a
+// finished step's line (ending in a newline) is left whole.
+TEST(Cli, RedrawnProgressLinesFitANarrowTerminal) {
+  if (std::system("script --version >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1) to give a terminal";
+  const std::string dir = temp_dir();
+  const std::string log = dir + "/log";
+  const std::string command = "script -qec \"stty cols 50; '" + std::string(HEXBITE_EXE) + "' mesh '" +
+                              write_case("cube.obj", cube_obj()) + "' --target-hexes 500 -o '" + dir +
+                              "/m.vtu'\" /dev/null >'" + log + "' 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << read_file(log);
+  const std::string text = read_file(log);
+  int redrawn = 0;
+  for (std::size_t at = text.find("\r\033[K"); at != std::string::npos; at = text.find("\r\033[K", at + 1)) {
+    const std::size_t from = at + 4, to = text.find_first_of("\r\n", from);
+    if (to == std::string::npos || text[to] == '\n' || text.compare(to, 2, "\r\n") == 0) continue;  // final
+    ++redrawn;
+    EXPECT_LE(to - from, 49u) << text.substr(from, to - from);
+  }
+  EXPECT_GT(redrawn, 0) << text;
+}
+
 // With --json, standard output is one JSON document, also without --quiet: `hexbite run ... --json | jq`
 // broke on the informational lines (the run's "not resolved: ..." parts) printed before the JSON. Every
 // command that has --json, on a small generated mandible and the shipped default scenario.
