@@ -367,9 +367,11 @@ constexpr double kProbeMaxOutsideMm = 5.0;
 // there; results.json reports that point and the distance moved. (It was moved onto the fan-triangulated
 // boundary and 1 % toward the hex's centre, which on a warped boundary quad could still lie outside the
 // curved hex: evaluated 0.02 mm elsewhere, or, 0.6 mm out, not at all, with zeros written.) A point farther
-// outside than kProbeMaxOutsideMm is refused at its line.
+// outside than kProbeMaxOutsideMm is refused at its line, on the coarse mesh (`coarse`) only: a refined
+// level's boundary lies elsewhere by a fraction of a millimetre, and a probe 4.997 mm from the coarse mesh
+// was refused at level 1 as "5.0 mm outside ... within 5 mm".
 std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& boundary,
-                                       const std::vector<Probe>& probes) {
+                                       const std::vector<Probe>& probes, bool coarse) {
   std::vector<Vec3> points;
   if (probes.empty()) return points;
   const SurfaceProjector mesh_boundary(fan_triangles(boundary.surface));
@@ -404,11 +406,11 @@ std::vector<Vec3> probe_points_in_mesh(const HexMesh& mesh, const HexBoundary& b
     // A point on the bone's surface lies at most a millimetre or two outside the mesh; one much farther
     // away is a typo or a point of another frame, and its values would be those of an unrelated place.
     const double outside = mesh_boundary.inside(p) ? 0.0 : vec3::norm(vec3::sub(foot.point, p));
-    if (outside > kProbeMaxOutsideMm) {
+    if (coarse && outside > kProbeMaxOutsideMm) {
       char buf[400];
       std::snprintf(
           buf, sizeof buf,
-          ": probe '%s' at (%.2f, %.2f, %.2f) lies %.1f mm outside the mesh (nearest boundary point "
+          ": probe '%s' at (%.2f, %.2f, %.2f) lies %.2f mm outside the mesh (nearest boundary point "
           "(%.2f, %.2f, %.2f)); a probe must be in the bone or within %.0f mm of it: check its "
           "coordinates and units",
           probe.name.c_str(), p[0], p[1], p[2], outside, foot.point[0], foot.point[1], foot.point[2],
@@ -470,7 +472,7 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const Leve
   for (std::size_t i = 0; i < s.supports.size(); ++i)
     if (s.supports[i].contact)
       r.contact_directions[i] = contact_direction(s.supports[i], r.support_patches[i], r.mesh);
-  r.probe_points = probe_points_in_mesh(r.mesh, boundary, s.probes);
+  r.probe_points = probe_points_in_mesh(r.mesh, boundary, s.probes, /*coarse=*/coarser == nullptr);
   r.hex_material.reserve(r.mesh.hexes.size());
   // A hex takes a region's material by its centre; a region that wins no hex changes nothing, which
   // must not pass for a simulated implant or resorption site. Checked on the coarse mesh (finer levels

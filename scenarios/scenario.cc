@@ -650,6 +650,12 @@ void check_unique_names(const std::vector<T>& items, const std::string& kind) {
       if (first->file == second->file &&
           std::tie(second->line, second->column) < std::tie(first->line, first->column))
         std::swap(first, second);
+      // A name written elsewhere than its item (a study's rename) is the one to name, whichever item comes
+      // first in the list.
+      const auto renamed = [](const T& item) {
+        return item.name_at.line > 0 && item.name_at.file != item.where.file;
+      };
+      if (renamed(items[j]) && !renamed(items[i])) std::swap(first, second);
       fail(*second, kind + " " + quote(items[i].name) + " is defined twice (first on line " +
                         std::to_string(first->line) +
                         (first->file == second->file ? "" : " of " + first->file) + "); give each " + kind +
@@ -770,7 +776,8 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
     for (const Value& item : to_list(*x)) {
       const Map p(item, {"name", "at"});
       const Value& name = p.require("name", "name: chin");
-      s.probes.push_back({to_string(name), to_point(p.require("at", "at: incisal_point")), item.at, name.at});
+      s.probes.push_back({to_string(name, "write a name such as chin"),
+                          to_point(p.require("at", "at: incisal_point")), item.at, name.at});
     }
   check_poisson_for_degree(s);
   check_unique_names(s.muscles, "muscle");

@@ -496,6 +496,33 @@ probes:
   EXPECT_NEAR(r["probes"]["outside"]["moved_mm"].get<double>(), 0.617, 0.01);
 }
 
+// A probe 4.997 mm outside the coarse mesh ran at level 0 and was refused at level 1 ("lies 5.0 mm outside
+// the mesh ...; within 5 mm of it"): the refined boundary lies elsewhere. The limit holds on the coarse mesh
+// only (helper M).
+TEST(RunScenario, AProbeAcceptedOnTheCoarseMeshIsPlacedOnEveryLevel) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/far.yaml", R"(name: far_probe
+geometry:
+  mandible: {variant: dentate}
+mesh: {method: grid, target_hexes: 1500, validation_levels: 1}
+activation_pattern:
+  superficial_masseter: 0.5
+  medial_pterygoid: 0.5
+supports:
+  - {name: nut, at: right_first_molar_bite_point, radius_mm: 4, bite: true}
+  - {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}
+  - {name: left_condyle, at: left_condyle_tmj_point, radius_mm: 6}
+probes:
+  - {name: far, at: [53.503312636, 7.153320814, 29.461226173]}
+)");
+  const json r = run_scenario(dir + "/far.yaml", dir + "/out");
+  ASSERT_TRUE(r.is_object());
+  for (const json& level : r["validation"]["levels"]) {
+    EXPECT_TRUE(level["probes"]["far"]["found"].get<bool>());
+    EXPECT_GT(level["probes"]["far"]["moved_mm"].get<double>(), 4.9);
+  }
+}
+
 // A bad scenario exits with 2, names the file and line, and leaves no output folder behind. Returns the
 // error message.
 std::string expect_refused(const std::string& text, const std::string& message,

@@ -285,6 +285,21 @@ TEST(Study, ARenameOntoAnotherNameIsNamedAtTheStudysLine) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("probe 'a' is defined twice (first on line"), std::string::npos) << r.err;
+  // The renamed item first in the list: still the study's line (helper M).
+  study.replace(study.find("probes.b.name: a"), 16, "probes.a.name: b");
+  test::write_file(dir + "/study.yaml", study);
+  const test::CommandResult first =
+      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(first.exit_code, 2) << first.err;
+  EXPECT_NE(first.err.find(dir + "/study.yaml:7:"), std::string::npos) << first.err;
+  EXPECT_NE(first.err.find("probe 'b' is defined twice (first on line"), std::string::npos) << first.err;
+  // An empty probe name gets a probe's example, not a support's (helper M).
+  study.replace(study.find("probes.a.name: b"), 16, "probes.a.name: \"\"");
+  test::write_file(dir + "/study.yaml", study);
+  const test::CommandResult empty =
+      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+  EXPECT_NE(empty.err.find("probes[0].name is empty; write a name such as chin"), std::string::npos)
+      << empty.err;
 }
 
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
