@@ -296,7 +296,7 @@ void check_inp_exportable(const Scenario& scenario) {
   for (const Support& s : scenario.supports)
     if (s.spring_N_per_mm3)
       throw InputError(
-          s.where.str() + ": support '" + s.name +
+          (s.spring_at.line ? s.spring_at : s.where).str() + ": support '" + s.name +
           "' is a spring (spring_N_per_mm3), which the CalculiX export does not write; "
           "use fixed components for the comparison with CalculiX, or leave the export out (--export inp, "
           "outputs.inp)");

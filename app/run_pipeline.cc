@@ -465,7 +465,11 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const Leve
     r.support_patches.push_back(
         coarser ? refined_patch(r.mesh, map, coarser->support_patches[r.support_patches.size()])
                 : select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
-                               point_place(sup.at, sup.where), "support '" + sup.name + "'"));
+                               // At a radius a study set (the base's point is not what changed).
+                               sup.radius_at.line && sup.radius_at.file != sup.where.file
+                                   ? sup.radius_at
+                                   : point_place(sup.at, sup.where),
+                               "support '" + sup.name + "'"));
   // Here, not before the solve: a contact that cannot push, or a probe far outside the mesh, must not cost a
   // study its earlier variants.
   r.contact_directions.assign(s.supports.size(), Vec3{0, 0, 0});

@@ -565,11 +565,15 @@ Support parse_support(const Value& item) {
   s.at = to_point(map.require("at", "at: right_condyle_tmj_point"));
   s.radius_mm =
       patch_radius(map.require("radius_mm", "radius_mm: 5"), "the support patch radius in mm, e.g. 5");
-  if (map.has("fixed") && map.has("spring_N_per_mm3"))
-    fail(map.key_at("spring_N_per_mm3"),
+  s.radius_at = written_at(map, "radius_mm");
+  if (map.has("fixed") && map.has("spring_N_per_mm3")) {
+    // At the one a study added, if it added one: the base's spring was named for a study's `fixed`.
+    const SourceLocation fixed = written_at(map, "fixed");
+    fail(fixed.file != item.at.file ? fixed : written_at(map, "spring_N_per_mm3"),
          "support " + quote(s.name) +
              " has both 'fixed' and 'spring_N_per_mm3'; a patch is either fixed "
              "or elastic, keep one");
+  }
   if (auto x = map.find("fixed")) {
     const auto items = to_list(*x);
     if (items.empty())
@@ -585,6 +589,7 @@ Support parse_support(const Value& item) {
     }
   }
   if (auto x = map.find("spring_N_per_mm3")) {
+    s.spring_at = written_at(map, "spring_N_per_mm3");
     s.spring_N_per_mm3 =
         positive(*x, "the foundation stiffness in N/mm^3 (traction per displacement), e.g. 50");
   }

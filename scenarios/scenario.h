@@ -144,8 +144,9 @@ struct Support {
   bool contact = false;
   SourceLocation where;
   // Where the name was written: a study that renames the support (supports.x.name) wrote it in the study
-  // file, and a clash of names is named there.
-  SourceLocation name_at;
+  // file, and a clash of names is named there. The same for the radius and the spring (messages about a
+  // patch that selects nothing, or a spring the CalculiX export cannot write).
+  SourceLocation name_at, radius_at, spring_at;
 };
 
 enum class LinearSolverChoice { kAuto, kCgAmg, kDirect };

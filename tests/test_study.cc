@@ -302,6 +302,42 @@ TEST(Study, ARenameOntoAnotherNameIsNamedAtTheStudysLine) {
       << empty.err;
 }
 
+// Values a study set were named at the base's lines (helper M): a radius that selects no facet at the
+// base's point, a `fixed` added to a base spring at the base's spring, a spring refused by --export inp at
+// the base's support.
+TEST(Study, SupportValuesTheStudySetAreNamedAtItsLines) {
+  struct Case {
+    std::string set, fragment;
+    std::vector<std::string> extra;
+    bool base_spring = false;  // the base gets a spring support 'elastic'
+  };
+  for (const Case& c : std::vector<Case>{
+           {"supports.base.radius_mm: 0.5", "support 'base' selects no surface facets", {}},
+           {"supports.elastic.fixed: [x, y, z]",
+            "support 'elastic' has both 'fixed' and 'spring_N_per_mm3'",
+            {},
+            true},
+           {"supports.base.spring_N_per_mm3: 40",
+            "which the CalculiX export does not write",
+            {"--export", "inp"}},
+       }) {
+    std::string study = kStudy;
+    study.replace(study.find("materials.default.E_MPa: 5500"), 29, c.set);
+    const std::string dir = study_folder(study);
+    std::string base = test::read_file(dir + "/base/cube.yaml");
+    if (c.base_spring)
+      base.replace(base.find("materials:"), 0,
+                   "  - {name: elastic, at: [20, 10, 10], radius_mm: 6, spring_N_per_mm3: 10}\n");
+    test::write_file(dir + "/base/cube.yaml", base);
+    std::vector<std::string> args = {"-q", "study", dir + "/study.yaml", "-o", dir + "/out"};
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    const test::CommandResult r = test::run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << c.set << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  }
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
