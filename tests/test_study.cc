@@ -281,25 +281,21 @@ TEST(Study, ARenameOntoAnotherNameIsNamedAtTheStudysLine) {
   std::string scenario = test::read_file(dir + "/base/cube.yaml");
   scenario += "probes:\n  - {name: a, at: [10, 10, 10]}\n  - {name: b, at: [12, 10, 10]}\n";
   test::write_file(dir + "/base/cube.yaml", scenario);
-  const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
-  EXPECT_EQ(r.exit_code, 2) << r.err;
-  EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("probe 'a' is defined twice (first on line"), std::string::npos) << r.err;
+  // The study with its line 7 set to `set_line`: refused at that line with `message`.
+  const auto expect_at_line_7 = [&](const std::string& set_line, const std::string& message) {
+    study.replace(study.find("probes."), study.find('\n', study.find("probes.")) - study.find("probes."),
+                  set_line);
+    test::write_file(dir + "/study.yaml", study);
+    const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+  };
+  expect_at_line_7("probes.b.name: a", "probe 'a' is defined twice (first on line");
   // The renamed item first in the list: still the study's line (helper M).
-  study.replace(study.find("probes.b.name: a"), 16, "probes.a.name: b");
-  test::write_file(dir + "/study.yaml", study);
-  const test::CommandResult first =
-      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
-  EXPECT_EQ(first.exit_code, 2) << first.err;
-  EXPECT_NE(first.err.find(dir + "/study.yaml:7:"), std::string::npos) << first.err;
-  EXPECT_NE(first.err.find("probe 'b' is defined twice (first on line"), std::string::npos) << first.err;
+  expect_at_line_7("probes.a.name: b", "probe 'b' is defined twice (first on line");
   // An empty probe name gets a probe's example, not a support's (helper M).
-  study.replace(study.find("probes.a.name: b"), 16, "probes.a.name: \"\"");
-  test::write_file(dir + "/study.yaml", study);
-  const test::CommandResult empty =
-      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
-  EXPECT_NE(empty.err.find("probes[0].name is empty; write a name such as chin"), std::string::npos)
-      << empty.err;
+  expect_at_line_7("probes.a.name: \"\"", "probes[0].name is empty; write a name such as chin");
 }
 
 // Values a study set were named at the base's lines (helper M): a radius that selects no facet at the
