@@ -304,14 +304,14 @@ void run_mesh(const MeshOptions& o) {
   else if (!is_quiet())
     std::cout << report_text(o, mesh, report, choice);
   if (!valid) {
-    const std::string list = hex_list_text(mesh, final_quality.inverted_hexes);
     if (o.allow_invalid) {
-      std::cerr << "hexbite: warning: wrote " << o.output << " with " << final_quality.inverted
-                << " inverted hexes on purpose (--allow-invalid): " << list << '\n';
+      std::cerr << "hexbite: warning: wrote " << o.output << " with "
+                << hex_count_text(final_quality.inverted) << " inverted on purpose (--allow-invalid): "
+                << hex_list_text(mesh, final_quality.inverted_hexes) << '\n';
       return;
     }
-    throw RunError(std::to_string(final_quality.inverted) + " hexes stay inverted after optimization: " +
-                   list + "; no mesh written (--allow-invalid writes it anyway" +
+    throw RunError(stay_inverted_text(mesh, final_quality.inverted_hexes) +
+                   "; no mesh written (--allow-invalid writes it anyway" +
                    (report.swept         ? "; the grid core, --core grid, may mesh it valid)"
                     : options.arch_frame ? "; the axis-aligned grid, --grid-frame axes, may mesh it valid)"
                                          : ")"));

@@ -94,8 +94,7 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
   }
   if (!valid && !o.allow_invalid)
     throw RunError(
-        std::to_string(report.quality.inverted) +
-        " hexes stay inverted after optimization: " + hex_list_text(mesh, report.quality.inverted_hexes) +
+        stay_inverted_text(mesh, report.quality.inverted_hexes) +
         "; a quad corner there may be reflex (a non-convex quad: no hex on it has a positive Jacobian at "
         "that corner) or the quads too bent for the hexes under them: check the quad surface there, or mesh "
         "the solid with --method grid; no mesh written (--allow-invalid writes it anyway)");

@@ -307,8 +307,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     std::cerr << "hexbite: warning: wrote " << qo.output << " on purpose (--allow-invalid): " << text << '\n';
   }
   if (sheet_report.inverted > 0 && !o.allow_invalid)
-    throw RunError(std::to_string(q.inverted) +
-                   " hexes stay inverted after optimization: " + hex_list_text(mesh, q.inverted_hexes) +
+    throw RunError(stay_inverted_text(mesh, q.inverted_hexes) +
                    "; no mesh written (--allow-invalid writes it anyway)");
   if (!qo.json) info("wrote " + qo.output);
 }

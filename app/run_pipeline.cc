@@ -141,6 +141,12 @@ void info_volume_fit(const BoundaryFitReport& fit, const MeshFidelity& fidelity)
   info(line);
 }
 
+// "2 hexes inverted: hex 12 at (...) mm, ...", for a mesh that cannot be solved on.
+std::string inverted_hexes_text(const HexMesh& mesh) {
+  const QualitySummary q = summarize_quality(mesh);
+  return hex_count_text(q.inverted_hexes.size()) + " inverted: " + hex_list_text(mesh, q.inverted_hexes);
+}
+
 // `method: grid`. A mesh that stays inverted cannot be solved on.
 HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* fidelity, std::string* core) {
   GridMeshOptions options;
@@ -175,13 +181,11 @@ HexMesh mesh_by_grid(const Scenario& s, const Geometry& geometry, MeshFidelity* 
   for (const std::string& line : unresolved_listing(report.fidelity.unresolved))
     info("not resolved: " + line);
   if (report.optimize.inverted > 0)
-    throw RunError("the grid mesher left " + std::to_string(report.optimize.inverted) +
-                   " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
-                   "; try another target" +
+    throw RunError(s.path + ": at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
+                   " the grid mesher left " + inverted_hexes_text(mesh) + "; try another target" +
                    (s.mesh.core == MeshCore::kSwept ? " or core: grid"
                     : s.mesh.arch_frame             ? " or grid_frame: axes"
-                                                    : "") +
-                   " (hexbite mesh shows where)");
+                                                    : ""));
   return mesh;
 }
 
@@ -241,9 +245,8 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     throw RunError("the sheet mesher's mesh at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
                    ": " + report.boundary_crossing_text + "; try a smaller target or method: grid");
   if (report.inverted > 0)
-    throw RunError("the sheet mesher left " + std::to_string(report.inverted) +
-                   " inverted hexes at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) + ": " +
-                   hex_list_text(mesh, report.sheets.quality.inverted_hexes) +
+    throw RunError(s.path + ": at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
+                   " the sheet mesher left " + inverted_hexes_text(mesh) +
                    "; try another target or method: grid");
   return mesh;
 }
@@ -910,9 +913,9 @@ RunResult prepare_run(Scenario scenario, int levels, bool in_study) {
     options.fit_volume = scenario.mesh.fit_volume;  // the coarse nodes keep their (fitted) places
     HexMesh fine = refine_to_surface(result.levels.back().mesh, projector.get(), options, &report);
     if (report.after.inverted > 0)
-      throw RunError("refinement level " + std::to_string(level) + " left " +
-                     std::to_string(report.after.inverted) +
-                     " inverted hexes; run with fewer validation levels (--levels) or another target_hexes");
+      throw RunError(scenario.path + ": refinement level " + std::to_string(level) + " left " +
+                     inverted_hexes_text(fine) +
+                     "; run with fewer validation levels (--levels) or another mesh.target_hexes");
     const double seconds = seconds_since(t);
     result.levels.push_back(prepare_level(scenario, level, std::move(fine), &result.levels.back()));
     require_fixed_supports_apart(scenario, result.levels.back());

@@ -165,4 +165,13 @@ std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes, st
   return out.str();
 }
 
+std::string hex_count_text(std::size_t n) {
+  return std::to_string(n) + (n == 1 ? " hex" : " hexes");
+}
+
+std::string stay_inverted_text(const HexMesh& mesh, const std::vector<int>& inverted) {
+  return hex_count_text(inverted.size()) + (inverted.size() == 1 ? " stays" : " stay") +
+         " inverted after optimization: " + hex_list_text(mesh, inverted);
+}
+
 }  // namespace hexbite

@@ -88,4 +88,10 @@ QualitySummary summarize_quality(const HexMesh& mesh, const HexQualityField& fie
 std::string hex_list_text(const HexMesh& mesh, const std::vector<int>& hexes, std::size_t shown = 20,
                           const std::function<std::string(int)>& label = {});
 
+// "1 hex", "3 hexes".
+std::string hex_count_text(std::size_t n);
+
+// "1 hex stays inverted after optimization: hex 12 at (...) mm" ("3 hexes stay ..."), listing `inverted`.
+std::string stay_inverted_text(const HexMesh& mesh, const std::vector<int>& inverted);
+
 }  // namespace hexbite
