@@ -213,6 +213,7 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
       }
   }
   options.fit_volume = s.mesh.fit_volume;
+  options.terms = scenario_terms();
   MandibleSheetReport report;
   HexMesh mesh;
   try {
@@ -221,10 +222,9 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
   } catch (const LocalRefinementError&) {
     throw;  // a bite point off the bone: the message starts with the support's line (point_names above)
   } catch (const InputError& e) {
-    throw InputError(
-        s.mesh.method_at.str() + ": mesh.method 'sheets' cannot place its mandible template: " + e.what() +
-        "; give landmarks with the template's points, or use method: grid for a bone that is not a "
-        "whole mandible");
+    // The message says what to do in the scenario's terms (options.terms).
+    throw InputError(s.mesh.method_at.str() +
+                     ": mesh.method 'sheets' cannot place its mandible template: " + e.what());
   } catch (const RunError& e) {
     throw RunError(std::string("the sheet mesher failed: ") + e.what() + "; use method: grid");
   }

@@ -54,9 +54,10 @@ QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* l
                                    const std::string& surface_name, const std::string& landmark_file,
                                    MandibleQuadReport* report, QuadSurfaceReport* check,
                                    const LocalRefinementOptions& refinement,
-                                   LocalRefinementReport* refinement_report) {
+                                   LocalRefinementReport* refinement_report, const InputTerms& terms) {
   MandibleQuadOptions options;
   options.target_quads = target_quads;
+  options.terms = terms;
   QuadSurface quads;
   try {
     quads = quad_surface_from_mandible(surface, landmarks, landmark_file, options, report);
@@ -104,13 +105,14 @@ HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* land
     long most = o.target_hexes;
     while (most > 8 && quads_for_target_hexes(most) > 200000) most = most * 99 / 100;
     while (quads_for_target_hexes(most + 1) <= 200000) ++most;
-    throw InputError("--target-hexes " + std::to_string(o.target_hexes) + " asks for a quad surface of " +
-                     std::to_string(q) + " quads, more than the 200,000 of the mandible template: give at " +
-                     "most " + std::to_string(most) + " hexes with --method sheets, or use --method grid");
+    throw InputError(
+        o.terms.target_hexes + " " + std::to_string(o.target_hexes) + " asks for a quad surface of " +
+        std::to_string(q) + " quads, more than the 200,000 of the mandible template: give at " + "most " +
+        std::to_string(most) + " hexes with " + o.terms.sheets_method + ", or use " + o.terms.grid_method);
   }
-  const QuadSurface quads = checked_mandible_quads(surface, landmarks, quads_for_target_hexes(o.target_hexes),
-                                                   o.surface_name, o.landmark_file, &report.quad,
-                                                   &report.quad_check, o.refinement, &report.refinement);
+  const QuadSurface quads = checked_mandible_quads(
+      surface, landmarks, quads_for_target_hexes(o.target_hexes), o.surface_name, o.landmark_file,
+      &report.quad, &report.quad_check, o.refinement, &report.refinement, o.terms);
 
   // Step 2. Cycle elimination keeps the quad vertices' ids, so the landmark vertices stay valid.
   SheetMeshOptions options;

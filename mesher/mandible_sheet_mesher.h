@@ -47,6 +47,7 @@
 #include "mesher/cycle_elimination.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh.h"
+#include "mesher/input_terms.h"
 #include "mesher/landmarks.h"
 #include "mesher/quad_check.h"
 #include "mesher/quad_local_refinement.h"
@@ -64,6 +65,7 @@ struct MandibleSheetOptions {
   // After the optimization, boundary nodes (the landmark nodes excepted) move off the surface until the
   // boundary quads straddle it (mesher/boundary_fit.h); off by default.
   bool fit_volume = false;
+  InputTerms terms;  // how messages name the user's choices
 };
 
 struct MandibleSheetReport {
@@ -91,7 +93,8 @@ QuadSurface checked_mandible_quads(const TriSurface& surface, const Landmarks* l
                                    const std::string& surface_name, const std::string& landmark_file,
                                    MandibleQuadReport* report, QuadSurfaceReport* check,
                                    const LocalRefinementOptions& refinement = {},
-                                   LocalRefinementReport* refinement_report = nullptr);
+                                   LocalRefinementReport* refinement_report = nullptr,
+                                   const InputTerms& terms = {});
 
 // Steps 1 to 5. `landmarks` may be null (extreme points place the template); `report` may be null.
 HexMesh mesh_mandible_by_sheets(const TriSurface& surface, const Landmarks* landmarks,

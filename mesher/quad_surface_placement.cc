@@ -393,7 +393,7 @@ struct Correspondence {
 };
 
 Correspondence correspond(const MandibleQuadTemplate& t, const TriSurface& surface,
-                          const Landmarks* landmarks, const std::string& file) {
+                          const Landmarks* landmarks, const std::string& file, const InputTerms& terms) {
   Correspondence c;
   if (!landmarks) {
     const auto target = extreme_points(surface.vertices);
@@ -402,7 +402,8 @@ Correspondence correspond(const MandibleQuadTemplate& t, const TriSurface& surfa
       if (it == target.end())
         throw InputError(
             "the surface has no points on both sides of x = 0, so it is not a mandible in the "
-            "generator's frame (+x subject's left); give --landmarks or use --method grid");
+            "generator's frame (+x subject's left); give " +
+            terms.landmarks + " or use " + terms.grid_method);
       c.names.push_back(name);
       c.sources.push_back(p);
       c.targets.push_back(it->second);
@@ -433,9 +434,8 @@ Correspondence correspond(const MandibleQuadTemplate& t, const TriSurface& surfa
     throw InputError("landmark file " + file + ": only " + std::to_string(c.names.size()) +
                      " of the points that place the mandible template are in it (at least 6 are needed, on "
                      "both rami and at the front); missing: " +
-                     list +
-                     ". Write them as 'hexbite generate mandible --landmarks' does, or leave out "
-                     "--landmarks to place the template by extreme points");
+                     list + ". Write them as 'hexbite generate mandible --landmarks' does, or leave out " +
+                     terms.landmarks + " to place the template by extreme points");
   }
   return c;
 }
@@ -1311,8 +1311,8 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
     std::snprintf(size, sizeof size, "%.4g mm", extent);
     throw InputError(std::string("the surface is ") + size +
                      " across (the largest side of its bounding box), but the mandible template places on "
-                     "mandibles 30 to 300 mm across: check the unit (--units m or cm, or units: in a "
-                     "scenario), or use --method grid");
+                     "mandibles 30 to 300 mm across: check the unit (" +
+                     options.terms.units + "), or use " + options.terms.grid_method);
   }
   MandibleQuadReport report;
   Progress progress("quad surface");
@@ -1320,7 +1320,7 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   report.macro_quads = static_cast<int>(tmpl.macro.quads.size());
 
   // 1-2. Correspondence and warp.
-  const Correspondence corr = correspond(tmpl, surface, landmarks, landmark_file);
+  const Correspondence corr = correspond(tmpl, surface, landmarks, landmark_file, options.terms);
   report.placement = landmarks ? "landmarks" : "extreme points";
   report.matched_points = corr.names;
   std::vector<double> lambda(corr.names.size());
@@ -1475,8 +1475,9 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
         " (limit " + std::to_string(static_cast<int>(options.max_hausdorff_mm)) +
         " mm). The surface must be a whole mandible in the generator's frame (+x subject's left, "
         "+y posterior, +z superior, mm)" +
-        (landmarks ? " with landmarks in the same frame" : "; --landmarks helps place it") +
-        ", or use --method grid");
+        (landmarks ? " with landmarks in the same frame"
+                   : "; " + options.terms.landmarks + " helps place it") +
+        ", or use " + options.terms.grid_method);
   }
   report.quads = static_cast<int>(fine.quads.size());
   const std::vector<Chord> fine_chords = find_chords(fine.quads, fine_edges);

@@ -96,6 +96,7 @@
 #include <vector>
 
 #include "mesher/hex_mesh.h"
+#include "mesher/input_terms.h"
 #include "mesher/landmarks.h"
 
 namespace hexbite {
@@ -122,6 +123,7 @@ struct MandibleQuadOptions {
   // Threads of the per-input-vertex loops (1 to 8; default 2, this machine's cores): each vertex's query
   // is answered on its own and the answers are combined in vertex order, so the quads do not depend on it.
   int threads = 2;
+  InputTerms terms;  // how messages name the user's choices
 };
 
 struct MandibleQuadReport {

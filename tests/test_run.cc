@@ -861,6 +861,27 @@ muscles:
   EXPECT_NE(err.find(landmarks), std::string::npos) << err;
 }
 
+// `method: sheets` on a bone that is no mandible advised command-line options in a scenario ("check the unit
+// (--units m or cm, ...), or use --method grid; give landmarks ..., or use method: grid ..."): the advice is
+// now in the scenario's keys, once.
+TEST(RunScenario, SheetsMethodOnAnotherSolidAdvisesTheScenariosKeys) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  std::string text = cube_on_a_floor("[0, 0, 1]", "");
+  text.replace(text.find("target_hexes"), 0, "method: sheets, ");
+  test::write_file(dir + "/cube.yaml", text);
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/cube.yaml", "-o", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(dir + "/cube.yaml:4:"), std::string::npos) << r.err;  // the line of `method`
+  EXPECT_NE(r.err.find("the surface is 20 mm across"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("check the unit (units: m or cm in geometry.surface), or use method: grid"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("--"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("method: grid", r.err.find("method: grid") + 1), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 // A run into the folder of an earlier run with more levels, --export inp or more ranks left that run's
 // solution_level1.vtu, model.inp and pieces beside the new files, as if they belonged to them; the same
 // names in a folder that held no run are the user's and stay.
