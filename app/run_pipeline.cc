@@ -242,8 +242,9 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     info(line);
   }
   if (!report.boundary_crossings.empty())
-    throw RunError("the sheet mesher's mesh at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
-                   ": " + report.boundary_crossing_text + "; try a smaller target or method: grid");
+    throw RunError(s.path + ": the sheet mesher's mesh at mesh.target_hexes = " +
+                   std::to_string(s.mesh.target_hexes) + ": " + report.boundary_crossing_text +
+                   "; try another target or method: grid");
   if (report.inverted > 0)
     throw RunError(s.path + ": at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
                    " the sheet mesher left " + inverted_hexes_text(mesh) +
