@@ -91,7 +91,12 @@ std::string phase_table(const OptimizeReport& r) {
 // The frame of the kept grid: the swept core's is the arch's (--core auto may keep it with --grid-frame
 // axes).
 std::string grid_frame_used(const MeshOptions& o, const GridMeshReport& r) {
-  return r.swept ? "arch" : r.principal_frame ? "principal" : o.grid_frame;
+  return r.swept ? "arch" : r.principal_frame ? "principal" : r.face_frame ? "faces" : o.grid_frame;
+}
+
+// A retry's count of inverted hexes, null when that frame was not tried.
+nlohmann::json tried_count(int inverted) {
+  return inverted >= 0 ? nlohmann::json(inverted) : nlohmann::json();
 }
 
 // --core auto's line: which core it kept, and why when not simply the swept one.
@@ -107,6 +112,7 @@ std::string report_text(const MeshOptions& o, const HexMesh& mesh, const GridMes
   out << "Meshed " << o.surface << " (grid + pillow"
       << (grid_frame_used(o, r) == "arch"        ? ", along the arch"
           : grid_frame_used(o, r) == "principal" ? ", along the principal axes"
+          : grid_frame_used(o, r) == "faces"     ? ", along the largest flat faces"
                                                  : "")
       << (r.swept ? ", swept core" : "") << "): " << mesh.hexes.size() << " hexes (" << r.core_hexes
       << " core + " << r.pillow_hexes << " pillow), " << mesh.vertices.size() << " nodes; target " << o.target
@@ -156,11 +162,14 @@ nlohmann::json report_json(const MeshOptions& o, const HexMesh& mesh, const Grid
   j["cells_in_dropped_components"] = r.cells_in_dropped_components;
   j["grid_attempts"] = r.attempts;
   j["grid_frame"] = grid_frame_used(o, r);
-  j["principal_retry"] = r.principal_retry
-                             ? nlohmann::json{{"axes_inverted", r.principal_retry->axes_inverted},
-                                              {"principal_inverted", r.principal_retry->principal_inverted},
-                                              {"kept", r.principal_retry->kept}}
-                             : nlohmann::json();
+  j["principal_retry"] =
+      r.principal_retry
+          ? nlohmann::json{{"axes_inverted", r.principal_retry->axes_inverted},
+                           {"principal_inverted", tried_count(r.principal_retry->principal_inverted)},
+                           {"faces_inverted", tried_count(r.principal_retry->faces_inverted)},
+                           {"kept", r.principal_retry->kept},
+                           {"kept_frame", r.principal_retry->kept_frame}}
+          : nlohmann::json();
   j["core"] = r.swept ? "swept" : "grid";
   j["core_requested"] = o.core;
   if (choice) j["core_reason"] = choice->reason;

@@ -1326,7 +1326,10 @@ static HexMesh grid_mesh_in_frame(const TriSurface& surface, const GridMeshOptio
     }
   }
   std::optional<PrincipalFrame> principal;
-  if (!arch && options.principal_frame) principal = principal_frame(surface);
+  if (!arch && options.face_frame)
+    principal = face_frame(surface);
+  else if (!arch && options.principal_frame)
+    principal = principal_frame(surface);
   CoreFrame frame;
   frame.arch = arch ? &*arch : nullptr;
   frame.principal = principal ? &*principal : nullptr;
@@ -1598,37 +1601,66 @@ static HexMesh grid_mesh_in_frame(const TriSurface& surface, const GridMeshOptio
   }
   report.seconds_fidelity = seconds_since(t0);
   report.seconds_total = seconds_since(t_start);
-  report.principal_frame = principal.has_value();
+  report.principal_frame = principal.has_value() && !options.face_frame;
+  report.face_frame = principal.has_value() && options.face_frame;
   if (report_out) *report_out = std::move(report);
   return mesh;
 }
 
 std::string principal_retry_text(const PrincipalRetry& retry) {
-  return "the grids along the coordinate axes left " + std::to_string(retry.axes_inverted) +
-         " inverted hexes; along the solid's principal axes " + std::to_string(retry.principal_inverted) +
-         ": kept " + (retry.kept ? "those" : "the first");
+  std::string text =
+      "the grids along the coordinate axes left " + std::to_string(retry.axes_inverted) + " inverted hexes";
+  if (retry.principal_inverted >= 0)
+    text += "; along the solid's principal axes " + std::to_string(retry.principal_inverted);
+  if (retry.faces_inverted >= 0)
+    text += "; along its largest flat faces " + std::to_string(retry.faces_inverted);
+  if (!retry.kept) return text + ": kept the first";
+  return text + ": kept those along the " + (retry.kept_frame == "faces" ? "faces" : "principal axes");
 }
 
 HexMesh grid_mesh(const TriSurface& surface, const GridMeshOptions& options, GridMeshReport* report_out) {
   GridMeshReport report;
   HexMesh mesh = grid_mesh_in_frame(surface, options, &report);
-  const bool retry = options.principal_retry && !options.principal_frame && !options.arch_frame &&
-                     !options.swept_core && report.optimize.inverted > 0;
-  const std::optional<PrincipalFrame> principal = retry ? principal_frame(surface) : std::nullopt;
-  if (principal && !principal->along_coordinate_axes()) {
-    GridMeshOptions along = options;
-    along.principal_frame = true;
-    GridMeshReport other;
-    HexMesh other_mesh = grid_mesh_in_frame(surface, along, &other);
-    PrincipalRetry tried{report.optimize.inverted, other.optimize.inverted,
-                         other.optimize.inverted < report.optimize.inverted};
-    const double seconds = report.seconds_total + other.seconds_total;
-    const int attempts = report.attempts + other.attempts;
-    if (tried.kept) {
-      mesh = std::move(other_mesh);
-      report = std::move(other);
-    }
-    report.principal_retry = tried;
+  const bool retry = options.principal_retry && !options.principal_frame && !options.face_frame &&
+                     !options.arch_frame && !options.swept_core && report.optimize.inverted > 0;
+  if (retry) {
+    PrincipalRetry tried;
+    tried.axes_inverted = report.optimize.inverted;
+    double seconds = report.seconds_total;
+    int attempts = report.attempts;
+    // Meshes in the frame and keeps that mesh when it has fewer inverted hexes, or as many and a better
+    // worst element (step 5's order); its count.
+    const auto measure = [](const GridMeshReport& r) {
+      return worst_element_measure(r.optimize.phases.back().quality);
+    };
+    const auto mesh_along = [&](bool faces) {
+      GridMeshOptions along = options;
+      along.principal_frame = !faces;
+      along.face_frame = faces;
+      GridMeshReport other;
+      HexMesh other_mesh = grid_mesh_in_frame(surface, along, &other);
+      seconds += other.seconds_total;
+      attempts += other.attempts;
+      const int inverted = other.optimize.inverted;
+      if (inverted < report.optimize.inverted ||
+          (inverted == report.optimize.inverted && tried.kept && measure(other) > measure(report))) {
+        mesh = std::move(other_mesh);
+        report = std::move(other);
+        tried.kept = true;
+        tried.kept_frame = faces ? "faces" : "principal";
+      }
+      return inverted;
+    };
+    const std::optional<PrincipalFrame> principal = principal_frame(surface);
+    if (principal && !principal->along_coordinate_axes()) tried.principal_inverted = mesh_along(false);
+    // The faces' frame also after a valid principal mesh: an L-shaped block's principal axes (its
+    // diagonal) can give a valid but poor one (SJ min 0.22 against 0.66 along its faces).
+    const std::optional<PrincipalFrame> faces = face_frame(surface);
+    const bool tried_already =
+        !faces || faces->along_coordinate_axes() ||
+        (principal && !principal->along_coordinate_axes() && same_axes(*faces, *principal));
+    if (!tried_already) tried.faces_inverted = mesh_along(true);
+    if (tried.principal_inverted >= 0 || tried.faces_inverted >= 0) report.principal_retry = tried;
     report.seconds_total = seconds;
     report.attempts = attempts;
   }

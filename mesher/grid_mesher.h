@@ -116,8 +116,11 @@ struct GridMeshOptions {
   // Lay the grid along the solid's principal axes (mesher/principal_frame.h) instead of the coordinate
   // axes. When principal_retry is on and the axes' grids leave inverted hexes (a solid with flat faces at an
   // angle to the axes), the principal axes' grids are meshed too and the mesh with fewer inverted hexes is
-  // kept (report.principal_retry). Neither applies with arch_frame or swept_core.
+  // kept (report.principal_retry). When that still leaves inverted hexes, the grids along the solid's
+  // largest flat faces (face_frame in mesher/principal_frame.h: an L-shaped block's principal axes lie
+  // along its diagonal) are tried the same way. None of this applies with arch_frame or swept_core.
   bool principal_frame = false;
+  bool face_frame = false;  // the grid along the largest flat faces instead (the retry's third frame)
   bool principal_retry = true;
   // The core swept across the dental arch (mesher/swept_core.h) instead of the grid cores: a grid over the
   // bone's side view with swept_layers hexes across the bone in each column, unshifted and shifted by half
@@ -204,21 +207,26 @@ struct MeshFidelity {
   std::vector<UnresolvedPart> unresolved;  // surface regions farther than half the mean edge length
 };
 
-// The principal axes' grids meshed after the axes' grids left inverted hexes (GridMeshOptions).
+// The principal axes' (and the flat faces') grids meshed after the axes' grids left inverted hexes
+// (GridMeshOptions).
 struct PrincipalRetry {
-  int axes_inverted = 0;       // inverted hexes of the axes' best grid
-  int principal_inverted = 0;  // and of the principal axes' best grid
-  bool kept = false;           // the principal axes' mesh was kept (it had fewer)
+  int axes_inverted = 0;        // inverted hexes of the axes' best grid
+  int principal_inverted = -1;  // and of the principal axes' best grid (-1: not tried, see below)
+  int faces_inverted = -1;      // and of the flat faces' (-1: not tried, as the others left none or it has
+                                // no such faces, or they lie along the axes already tried)
+  bool kept = false;            // a retry's mesh was kept (it had fewer)
+  std::string kept_frame = "axes";  // the frame kept: "axes", "principal" or "faces"
 };
 
-// "the grids along the coordinate axes left 2 inverted hexes; along the solid's principal axes 0: kept
-// those", for `mesh` and `run`.
+// "the grids along the coordinate axes left 2 inverted hexes; along the solid's principal axes 1; along its
+// largest flat faces 0: kept those", for `mesh` and `run`.
 std::string principal_retry_text(const PrincipalRetry& retry);
 
 struct GridMeshReport {
   // Grids tried (GridMeshOptions::grids; with fine cells 4, or 6 with the mean or the defect retry).
   int attempts = 1;
   bool principal_frame = false;                   // the kept grid lies along the principal axes
+  bool face_frame = false;                        // the kept grid lies along the largest flat faces
   std::optional<PrincipalRetry> principal_retry;  // when it was tried
   double cell_size = 0;                           // h, mm (this and the fields below describe the kept grid)
   std::array<int, 3> grid{};                      // grid cells per axis

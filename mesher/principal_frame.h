@@ -31,4 +31,16 @@ struct PrincipalFrame {
 // a cube: no axis to prefer) or the surface has no area.
 std::optional<PrincipalFrame> principal_frame(const TriSurface& surface);
 
+// The frame of the solid's largest flat faces: its z along the normal shared by the largest area of
+// triangles (within 3 degrees, either sign), its x along the normal of the largest area among the
+// triangles at right angles to that (within 3 degrees), y completing it; centred like principal_frame.
+// For solids whose principal axes do not follow their faces: an L-shaped block's lie along its diagonal
+// (its two arms have equal moments), so a grid along them cuts every side face at 45 degrees. nullopt when
+// either direction gathers less than a tenth of the surface's area (no flat faces: a mandible, a sphere).
+// Cost: two passes over the triangles (the normals binned in cells of about 3 degrees).
+std::optional<PrincipalFrame> face_frame(const TriSurface& surface);
+
+// Whether every axis of `a` lies within `degrees` of an axis of `b` (the two grids are the same).
+bool same_axes(const PrincipalFrame& a, const PrincipalFrame& b, double degrees = 2.0);
+
 }  // namespace hexbite

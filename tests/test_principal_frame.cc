@@ -54,5 +54,29 @@ TEST(PrincipalFrame, ACubeHasNoAxisToPrefer) {
   EXPECT_FALSE(principal_frame(test::box(10, 10, 10)).has_value());
 }
 
+// The largest flat faces give an L-shaped block's own axes, turned with it, where its principal axes lie
+// along its diagonal; a solid without flat faces has none.
+TEST(FaceFrame, AnLShapedBlockGetsItsFacesNormals) {
+  const TriSurface block = test::l_block(40, 10, 10);
+  const std::optional<PrincipalFrame> principal = principal_frame(test::rotated(block, {0, 0, 1}, 45));
+  ASSERT_TRUE(principal.has_value());
+  EXPECT_TRUE(principal->along_coordinate_axes());  // the diagonal, turned onto x and y
+  const TriSurface turned_block = test::rotated(block, {1, 2, 3}, 33);
+  const std::optional<PrincipalFrame> f = face_frame(turned_block);
+  ASSERT_TRUE(f.has_value());
+  EXPECT_FALSE(f->along_coordinate_axes());
+  // Each axis along one of the block's turned axes; z along its largest faces (top and bottom: 1,400 mm^2
+  // against 800 for the sides along x or y).
+  TriSurface units;
+  units.vertices = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  units = test::rotated(units, {1, 2, 3}, 33);
+  for (const Vec3& unit : units.vertices) EXPECT_NEAR(largest_alignment(*f, unit), 1.0, 1e-9);
+  const Vec3& z = units.vertices[2];
+  EXPECT_NEAR(std::abs(f->axes[2][0] * z[0] + f->axes[2][1] * z[1] + f->axes[2][2] * z[2]), 1.0, 1e-9);
+  EXPECT_TRUE(same_axes(*f, *f));
+  EXPECT_FALSE(same_axes(*f, *principal));
+  EXPECT_FALSE(face_frame(test::torus(64, 32)).has_value());
+}
+
 }  // namespace
 }  // namespace hexbite

@@ -1245,56 +1245,32 @@ TEST(RunScenario, SolverOutOfIterationsNamesTheScenariosSettings) {
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
-// An L-shaped block 40 x 40 x 10 mm turned by 33 degrees about (1, 2, 3), as OBJ text with the coordinates
-// in single precision (as an STL file has them): neither the axes' grids nor the principal axes' mesh it
-// valid at 1,500 hexes (1-4 hexes stay inverted, depending on round-off: in double precision it meshes
-// valid).
-std::string turned_l_block_obj() {
-  const double angle = 33.0 * M_PI / 180.0, c = std::cos(angle), s = std::sin(angle), n = std::sqrt(14.0);
-  const double x = 1 / n, y = 2 / n, z = 3 / n;
-  const double r[3][3] = {{c + x * x * (1 - c), x * y * (1 - c) - z * s, x * z * (1 - c) + y * s},
-                          {y * x * (1 - c) + z * s, c + y * y * (1 - c), y * z * (1 - c) - x * s},
-                          {z * x * (1 - c) - y * s, z * y * (1 - c) + x * s, c + z * z * (1 - c)}};
-  const double outline[6][2] = {{0, 0}, {40, 0}, {40, 10}, {10, 10}, {10, 40}, {0, 40}};
-  std::ostringstream obj;
-  obj.precision(12);
-  for (const double height : {0.0, 10.0})  // vertices 1-6 at the bottom, 7-12 at the top
-    for (const auto& p : outline) {
-      obj << 'v';
-      for (const auto& row : r) obj << ' ' << float(row[0] * p[0] + row[1] * p[1] + row[2] * height);
-      obj << '\n';
-    }
-  for (int k = 2; k <= 5; ++k)
-    obj << "f 1 " << k + 1 << ' ' << k << "\nf 7 " << k + 6 << ' ' << k + 7 << '\n';
-  for (int i = 1; i <= 6; ++i) {
-    const int j = i % 6 + 1;
-    obj << "f " << i << ' ' << j << ' ' << j + 6 << "\nf " << i << ' ' << j + 6 << ' ' << i + 6 << '\n';
-  }
-  return obj.str();
-}
-
-// A run whose mesh kept an inverted hex said "the grid mesher left 1 inverted hexes ... (hexbite mesh shows
-// where)", naming neither the hex nor the scenario, where `hexbite mesh` names every one.
+// A run whose mesh kept an inverted hex said "the grid mesher left 2 inverted hexes ... (hexbite mesh shows
+// where)", naming neither the hexes nor the scenario, where `hexbite mesh` names every one. The generator's
+// corner (the smallest arch and body with the widest ramus and the most obtuse gonial angle) keeps 2
+// inverted hexes with the swept core at 3,000 hexes.
 TEST(RunScenario, AnInvertedCoarseMeshIsNamedHexByHex) {
   const std::string dir = test::temp_dir();
-  test::write_file(dir + "/l.obj", turned_l_block_obj());
-  test::write_file(dir + "/l.yaml", R"(name: l_block
+  test::write_file(dir + "/corner.yaml", R"(name: corner
 geometry:
-  surface: {file: l.obj}
-mesh: {target_hexes: 1500, validation_levels: 0}
-muscles:
-  - {name: pull, activation: 1, insertion: [0, 0, 0], radius_mm: 5, direction: [0, 0, 1], max_force_N: 100}
+  mandible: {arch_width_mm: 75, arch_depth_mm: 40, body_height_mm: 8, body_thickness_mm: 8,
+             ramus_height_mm: 40, ramus_width_mm: 40, gonial_angle_deg: 140}
+mesh: {target_hexes: 3000, validation_levels: 0, core: swept}
+activation_pattern:
+  superficial_masseter: {right: 0.56, left: 0.20}
 supports:
-  - {name: clamp, at: [0, 0, 0], radius_mm: 5}
-outputs: {bite_force: false}
+  - {name: nut, at: right_first_molar_bite_point, radius_mm: 4, bite: true}
+  - {name: right_condyle, at: right_condyle_tmj_point, radius_mm: 6}
+  - {name: left_condyle, at: left_condyle_tmj_point, radius_mm: 6}
 )");
-  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/l.yaml", "-o", dir + "/out"});
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/corner.yaml", "-o", dir + "/out"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find(dir + "/l.yaml: at mesh.target_hexes = 1500 the grid mesher left "), std::string::npos)
+  EXPECT_NE(r.err.find(dir + "/corner.yaml: at mesh.target_hexes = 3000 the grid mesher left "),
+            std::string::npos)
       << r.err;
   const std::string hex = R"(hex \d+ at \(-?[\d.]+, -?[\d.]+, -?[\d.]+\) mm)";
   EXPECT_TRUE(std::regex_search(r.err, std::regex("left (1 hex|[2-9] hexes) inverted: " + hex + "(, " + hex +
-                                                  ")*; try another target")))
+                                                  ")*; try another target or core: grid")))
       << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }

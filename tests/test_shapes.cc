@@ -62,4 +62,35 @@ TriSurface box(double a, double b, double c) {
   return s;
 }
 
+TriSurface l_block(double arm, double width, double height) {
+  const double outline[6][2] = {{0, 0}, {arm, 0}, {arm, width}, {width, width}, {width, arm}, {0, arm}};
+  TriSurface s;
+  for (const double z : {0.0, height})  // vertices 0-5 at the bottom, 6-11 at the top
+    for (const auto& p : outline) s.vertices.push_back({p[0], p[1], z});
+  for (int k = 1; k <= 4; ++k) {  // the outline is star-shaped from vertex 0: a fan
+    s.triangles.push_back({0, k + 1, k});
+    s.triangles.push_back({6, k + 6, k + 7});
+  }
+  for (int i = 0; i < 6; ++i) {
+    const int j = (i + 1) % 6;
+    s.triangles.push_back({i, j, j + 6});
+    s.triangles.push_back({i, j + 6, i + 6});
+  }
+  return s;
+}
+
+TriSurface rotated(TriSurface s, const Vec3& axis, double degrees) {
+  const double n = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+  const double x = axis[0] / n, y = axis[1] / n, z = axis[2] / n;
+  const double c = std::cos(degrees * M_PI / 180.0), k = std::sin(degrees * M_PI / 180.0), d = 1 - c;
+  const double r[3][3] = {{c + x * x * d, x * y * d - z * k, x * z * d + y * k},
+                          {y * x * d + z * k, c + y * y * d, y * z * d - x * k},
+                          {z * x * d - y * k, z * y * d + x * k, c + z * z * d}};
+  for (Vec3& v : s.vertices) {
+    const Vec3 p = v;
+    for (int a = 0; a < 3; ++a) v[a] = r[a][0] * p[0] + r[a][1] * p[1] + r[a][2] * p[2];
+  }
+  return s;
+}
+
 }  // namespace hexbite::test
