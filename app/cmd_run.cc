@@ -42,6 +42,7 @@ struct RunCliOptions {
 void run_run(const RunCliOptions& o) {
   const bool root = MpiSession::rank() == 0;
   Scenario scenario = load_scenario(o.scenario);
+  refuse_inputs_among_outputs(scenario_inputs(scenario), o.output, is_run_output_name);
   const int levels = o.levels ? *o.levels : scenario.mesh.validation_levels;
   const bool export_inp =
       std::count(o.export_formats.begin(), o.export_formats.end(), "inp") > 0 || scenario.outputs.inp;

@@ -16,6 +16,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,25 @@ void run_study(const StudyCliOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   Study study = load_study(o.study);
   const std::size_t count = study.variants.size();
+  {
+    // The study file, the base, and every variant's files: none may be replaced by study.json, study.md,
+    // study.csv or a file of a variant's run folder.
+    std::vector<std::pair<std::string, std::string>> inputs = {{study.path, "the study file"},
+                                                               {study.base, "the base scenario"}};
+    std::set<std::string> folders;
+    for (const StudyVariant& v : study.variants) {
+      folders.insert(v.name);
+      for (auto& input : scenario_inputs(v.scenario))
+        if (input.second != "the scenario") inputs.push_back(std::move(input));
+    }
+    refuse_inputs_among_outputs(inputs, o.output, [&folders](const std::string& name) {
+      const std::size_t slash = name.find('/');
+      if (slash == std::string::npos)
+        return name == "study.json" || name == "study.md" || name == "study.csv";
+      return folders.count(name.substr(0, slash)) > 0 && name.find('/', slash + 1) == std::string::npos &&
+             is_run_output_name(name.substr(slash + 1));
+    });
+  }
   const auto counted = [&](std::size_t i) {
     return std::to_string(i + 1) + " / " + std::to_string(count) + ": " + study.variants[i].name;
   };

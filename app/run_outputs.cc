@@ -423,12 +423,46 @@ void broadcast(std::string* text, int root) {
 }  // namespace
 
 bool is_earlier_run_output(const std::string& dir, const std::string& name) {
-  static const std::regex kOutputName(
-      R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
   const std::filesystem::path path = std::filesystem::path(dir) / name;
   std::error_code ec;
-  return std::regex_match(path.filename().string(), kOutputName) &&
+  return path.filename() != "results.json" && is_run_output_name(path.filename().string()) &&
          std::filesystem::is_regular_file(path.parent_path() / "results.json", ec);
+}
+
+bool is_run_output_name(const std::string& filename) {
+  static const std::regex kOutputName(
+      R"((results\.json|mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
+  return std::regex_match(filename, kOutputName);
+}
+
+std::vector<std::pair<std::string, std::string>> scenario_inputs(const Scenario& scenario) {
+  std::vector<std::pair<std::string, std::string>> inputs = {{scenario.path, "the scenario"}};
+  if (!scenario.geometry.file.empty()) inputs.push_back({scenario.geometry.file, "the geometry file"});
+  if (!scenario.landmarks.file.empty()) inputs.push_back({scenario.landmarks.file, "the landmark file"});
+  return inputs;
+}
+
+void refuse_inputs_among_outputs(const std::vector<std::pair<std::string, std::string>>& inputs,
+                                 const std::string& dir,
+                                 const std::function<bool(const std::string&)>& is_output) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(dir, ec);
+  if (ec) return;  // the folder's own check reports what is wrong with it
+  for (const auto& [input, what] : inputs) {
+    const fs::path path(input);
+    if (!fs::is_regular_file(fs::symlink_status(path, ec))) continue;  // a link is replaced, not its target
+    // The input's folder resolved, its own name kept: where a rename into DIR would land.
+    const fs::path folder = fs::weakly_canonical(fs::absolute(path, ec).parent_path(), ec);
+    if (ec) continue;
+    const fs::path relative = (folder / path.filename()).lexically_relative(out);
+    if (relative.empty() || *relative.begin() == "..") continue;
+    if (is_output(relative.generic_string()))
+      throw InputError("'" + input + "' is " + what + " of this command, and it writes its own '" +
+                       relative.generic_string() + "' into '" + dir +
+                       "': the input would be replaced by an output; choose another output folder (-o) or "
+                       "rename the input");
+  }
 }
 
 RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {

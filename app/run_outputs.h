@@ -31,6 +31,22 @@ nlohmann::json results_json(const RunResult& result, double seconds_output);
 // results.json. Without that a folder held no run: the user's own model.inp there was removed.
 bool is_earlier_run_output(const std::string& dir, const std::string& name);
 
+// Whether a file of this name (no folder) is one that a run writes or removes: results.json, mesh.vtu,
+// model.inp, model_mesh.inp, solution*.vtu / .pvtu and their pieces.
+bool is_run_output_name(const std::string& filename);
+
+// The files a run of `scenario` reads, each with what it is: "the scenario", "the geometry file", "the
+// landmark file".
+std::vector<std::pair<std::string, std::string>> scenario_inputs(const Scenario& scenario);
+
+// Refuses (InputError, exit 2) to write into `dir` when one of `inputs` (path, what it is) lies in it under a
+// name that `is_output` (given the name relative to `dir`, "results.json" or "soft/model.inp") says the
+// command writes or removes: the input would be replaced by an output (a study file named study.json
+// became the study's results). A symbolic link under such a name is not its target and is not refused.
+void refuse_inputs_among_outputs(const std::vector<std::pair<std::string, std::string>>& inputs,
+                                 const std::string& dir,
+                                 const std::function<bool(const std::string&)>& is_output);
+
 // The files of a run into DIR, all or nothing. Every rank constructs one and calls write() and commit()
 // together. An error of any rank (disk full, a folder in the way of a file name) makes every rank throw
 // the same error (RunError), so that rank 0 reports it once; the files of this run are then removed, and

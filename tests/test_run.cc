@@ -1275,6 +1275,27 @@ supports:
   EXPECT_FALSE(fs::exists(dir + "/out"));
 }
 
+// A scenario named results.json run into its own folder was replaced by the run's results.json (exit 0):
+// an input under the name of an output in DIR (the scenario, its surface, its landmarks) is refused before
+// any work.
+TEST(RunScenario, AnInputThatAnOutputWouldReplaceIsRefused) {
+  const std::string dir = test::temp_dir();
+  const std::string text = cube_on_a_floor("[0, 0, 1]", "");
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  test::write_file(dir + "/results.json", text);
+  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/results.json", "-o", dir + "/."});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("'" + dir +
+                       "/results.json' is the scenario of this command, and it writes its own "
+                       "'results.json' into '" +
+                       dir + "/.'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(test::read_file(dir + "/results.json"), text);
+  // Into another folder it runs.
+  EXPECT_EQ(test::run_hexbite({"-q", "run", dir + "/results.json", "-o", dir + "/out"}).exit_code, 0);
+}
+
 // One fixed support over a muscle's whole insertion (it was a 1000 mm support over the whole bone, before
 // patch radii were limited to 50 mm): the muscle's force went straight into the reaction, exit 0.
 TEST(RunScenario, MuscleWhollyOnFixedNodesIsRefused) {

@@ -582,5 +582,30 @@ TEST(Study, AFailedVariantLeavesTheOutputFolderAsItWas) {
   EXPECT_FALSE(fs::exists(dir + "/new")) << r.err;
 }
 
+// A study file named study.json (a JSON study is valid YAML), studied into its own folder, was replaced by
+// the study's results with exit 0; so was a base named results.json inside a variant's folder. An input that
+// an output would replace is refused before any work, and stays as it was.
+TEST(Study, AnInputThatAnOutputWouldReplaceIsRefused) {
+  for (const auto& [study_name, base] : std::vector<std::pair<std::string, std::string>>{
+           {"study.json", "base/cube.yaml"}, {"study.yaml", "reference/results.json"}}) {
+    const std::string dir = study_folder(kStudy);
+    std::string study = kStudy;
+    study.replace(study.find("base/cube.yaml"), 14, base);
+    if (base != "base/cube.yaml") {
+      fs::create_directories(dir + "/reference");
+      test::write_file(dir + "/" + base, test::read_file(dir + "/base/cube.yaml"));
+      test::write_file(dir + "/reference/cube.obj", test::cubes_obj(1));
+    }
+    test::write_file(dir + "/" + study_name, study);
+    const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/" + study_name, "-o", dir});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    const std::string replaced = study_name == "study.json" ? study_name : base;
+    EXPECT_NE(r.err.find("it writes its own '" + replaced + "' into '" + dir + "'"), std::string::npos)
+        << r.err;
+    EXPECT_EQ(test::read_file(dir + "/" + study_name), study);
+    EXPECT_FALSE(fs::exists(dir + "/soft"));
+  }
+}
+
 }  // namespace
 }  // namespace hexbite
