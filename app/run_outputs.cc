@@ -403,6 +403,15 @@ json results_json(const RunResult& r, double seconds_output) {
     mesh_seconds.push_back(l.seconds_mesh);
     solve_seconds.push_back(l.seconds_solve);
   }
+  const TrustLimits limits = trust_limits(r);
+  bool passed = true;
+  for (const LevelResult& l : r.levels)
+    passed = passed && l.solution.equilibrium_residual <= limits.equilibrium_residual &&
+             l.solution.max_displacement <= limits.max_displacement_mm;
+  j["checks"] = {{"passed", passed},
+                 {"equilibrium_residual_limit", limits.equilibrium_residual},
+                 {"max_displacement_limit_mm", limits.max_displacement_mm},
+                 {"bone_size_mm", limits.bone_size_mm}};
   j["seconds"] = {{"geometry", r.seconds_geometry},
                   {"mesh_per_level", mesh_seconds},
                   {"solve_per_level", solve_seconds},

@@ -242,9 +242,9 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     info(line);
   }
   if (!report.boundary_crossings.empty())
-    throw RunError(s.path + ": the sheet mesher's mesh at mesh.target_hexes = " +
-                   std::to_string(s.mesh.target_hexes) + ": " + report.boundary_crossing_text +
-                   "; try another target or method: grid");
+    throw RunError(s.path +
+                   ": the sheet mesher's mesh at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
+                   ": " + report.boundary_crossing_text + "; try another target or method: grid");
   if (report.inverted > 0)
     throw RunError(s.path + ": at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
                    " the sheet mesher left " + inverted_hexes_text(mesh) +
@@ -956,10 +956,16 @@ void solve_run(RunResult& result) {
   result.seconds_total += seconds_since(start);
 }
 
-void require_trustworthy(const RunResult& result, const std::string& results) {
+TrustLimits trust_limits(const RunResult& result) {
   const double size = largest_extent(result.levels.front().mesh.vertices);
+  return {kEquilibriumTolerance, kMaxDisplacementFraction * size, size};
+}
+
+void require_trustworthy(const RunResult& result, const std::string& results) {
+  const TrustLimits limits = trust_limits(result);
+  const double size = limits.bone_size_mm;
   for (const LevelResult& l : result.levels) {
-    if (!(l.solution.equilibrium_residual <= kEquilibriumTolerance)) {
+    if (!(l.solution.equilibrium_residual <= limits.equilibrium_residual)) {
       // %.3g: std::to_string printed a residual of 3e-8 as "0.000000 > 1e-8".
       const SolverSpec& solver = result.scenario.solver;
       char text[160];
@@ -974,7 +980,7 @@ void require_trustworthy(const RunResult& result, const std::string& results) {
                      " are not trustworthy: tighten solver.tolerance (" + tolerance +
                      (at.line ? std::string() : std::string(", the default")) + ")");
     }
-    if (l.solution.max_displacement > kMaxDisplacementFraction * size) {
+    if (!(l.solution.max_displacement <= limits.max_displacement_mm)) {
       char text[400];
       std::snprintf(text, sizeof text,
                     "level %d: the largest displacement, %.3g mm, is more than %.0f %% of the bone's size "

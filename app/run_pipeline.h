@@ -88,4 +88,14 @@ void solve_run(RunResult& result);
 // `results` names the results in question for the message ("the results in out").
 void require_trustworthy(const RunResult& result, const std::string& results);
 
+// The limits of those checks for this run (results.json's `checks`, so that a report of a failed run's
+// kept files can say so): the relative equilibrium residual (1e-8) and the largest displacement, 10 % of
+// the coarse mesh's largest extent (`bone_size_mm`).
+struct TrustLimits {
+  double equilibrium_residual = 0;
+  double max_displacement_mm = 0;
+  double bone_size_mm = 0;
+};
+TrustLimits trust_limits(const RunResult& result);
+
 }  // namespace hexbite

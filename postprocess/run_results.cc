@@ -278,6 +278,11 @@ RunFigures read_run_figures(const std::string& path) {
       r.support_hold.push_back(s);
     });
   if (c.has(top, "hexbite_version")) r.hexbite_version = c.text(c.child(top, "hexbite_version"));
+  if (c.has(top, "checks")) {
+    const Key checks = c.child(top, "checks");
+    r.max_displacement_limit = c.number(checks, "max_displacement_limit_mm");
+    r.bone_size = c.number(checks, "bone_size_mm");
+  }
   read_model(c, top, r);
   std::vector<std::string> support_order;
   for (const SupportFigures& s : r.supports) support_order.push_back(s.name);

@@ -251,6 +251,40 @@ TEST(ReportWarnings, WeakSupportsAreWarnedAboutFirst) {
   EXPECT_NE(c.err.find("hexbite: warning: Weak supports"), std::string::npos) << c.err;
 }
 
+// A run whose largest displacement broke the small-displacement check (E in GPa typed for MPa) exits 1 but
+// keeps its files, and its report gave every figure as a result with "0 warnings". results.json now holds
+// the check's limit, and the report says first that the figures are meaningless.
+TEST(ReportWarnings, AFailedSmallDisplacementCheckIsWarnedAbout) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/cube.obj", test::cubes_obj(1));
+  write_file(dir + "/cube.yaml", cube_without_levels_and_supports() +
+                                     "supports:\n  - {name: nut, at: [0, 10, 10], radius_mm: 5, bite: true}\n"
+                                     "materials: {default: {E_MPa: 1}}\n");
+  const test::CommandResult run = run_hexbite({"-q", "run", dir + "/cube.yaml", "-o", dir + "/run"});
+  ASSERT_EQ(run.exit_code, 1) << run.err;
+  ASSERT_NE(run.err.find("the largest displacement"), std::string::npos) << run.err;
+  const json checks = json::parse(read_file(dir + "/run/results.json"))["checks"];
+  EXPECT_FALSE(checks["passed"].get<bool>()) << checks.dump();
+  EXPECT_NEAR(checks["max_displacement_limit_mm"].get<double>(), 0.1 * checks["bone_size_mm"].get<double>(),
+              1e-12);
+  EXPECT_NEAR(checks["bone_size_mm"].get<double>(), 20.0, 0.5);  // the cube's largest extent
+  const std::string out = dir + "/failed.html";
+  const test::CommandResult c =
+      run_hexbite({"-q", "report", dir + "/run", "-o", out, "--no-pictures", "--json"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const json summary = json::parse(c.out);
+  ASSERT_GE(summary["warnings"].size(), 1u) << summary.dump();
+  EXPECT_NE(summary["warnings"][0].get<std::string>().find("Small displacements: on level 0 the largest "
+                                                           "displacement"),
+            std::string::npos)
+      << summary.dump();
+  EXPECT_NE(section(read_file(out), "Warnings").find("every figure of this report is meaningless"),
+            std::string::npos);
+  // A run that passed says so, and its report has no such warning.
+  const json passed = json::parse(read_file(run_cube(kCube) + "/results.json"))["checks"];
+  EXPECT_TRUE(passed["passed"].get<bool>()) << passed.dump();
+}
+
 // What was simulated is in the report, from results.json alone: the materials with the hexes each takes, the
 // muscle loads, and each support's condition (fixed components or a spring), centre and radius.
 TEST(ReportModel, StatesTheMaterialsTheLoadsAndTheSupports) {
