@@ -26,40 +26,34 @@ namespace {
 constexpr int kSlots = 32;
 constexpr std::size_t kSlotBytes = 4096;
 char g_paths[kSlots][kSlotBytes];
-std::atomic<int> g_state[kSlots];  // 0 free, 1 being filled, 2 registered
-
-// Registers `path` for removal on SIGINT, SIGTERM and SIGHUP while it lives.
-class TemporaryRegistration {
- public:
-  explicit TemporaryRegistration(const std::string& path) {
-    if (path.size() >= kSlotBytes) return;
-    for (int i = 0; i < kSlots; ++i) {
-      int expected = 0;
-      if (!g_state[i].compare_exchange_strong(expected, 1)) continue;
-      std::memcpy(g_paths[i], path.c_str(), path.size() + 1);
-      g_state[i].store(2);
-      slot_ = i;
-      return;
-    }
-  }
-  ~TemporaryRegistration() {
-    if (slot_ >= 0) g_state[slot_].store(0);
-  }
-  TemporaryRegistration(const TemporaryRegistration&) = delete;
-  TemporaryRegistration& operator=(const TemporaryRegistration&) = delete;
-
- private:
-  int slot_ = -1;
-};
+std::atomic<int> g_state[kSlots];  // 0 free, 1 being filled, 2 a registered file, 3 a registered folder
 
 extern "C" void remove_temporaries_and_die(int signal_number) {
   for (int i = 0; i < kSlots; ++i)
     if (g_state[i].load() == 2) ::unlink(g_paths[i]);
+  for (int i = 0; i < kSlots; ++i)  // folders after their files
+    if (g_state[i].load() == 3) ::rmdir(g_paths[i]);
   std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
 }
 
 }  // namespace
+
+RemovedOnSignal::RemovedOnSignal(const std::string& path, Kind kind) {
+  if (path.size() >= kSlotBytes) return;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (!g_state[i].compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(g_paths[i], path.c_str(), path.size() + 1);
+    g_state[i].store(kind == kFolder ? 3 : 2);
+    slot_ = i;
+    return;
+  }
+}
+
+RemovedOnSignal::~RemovedOnSignal() {
+  if (slot_ >= 0) g_state[slot_].store(0);
+}
 
 void remove_temporary_files_on_signals() {
   static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads these atomics");
@@ -73,7 +67,7 @@ void write_atomically(const std::string& final_path, const std::function<void(co
     throw InputError("cannot write '" + final_path + "': directory '" + dir.string() +
                      "' does not exist; create it first");
   const std::string tmp = temporary_path_beside(final_path, target.extension().string());
-  const TemporaryRegistration registered(tmp);
+  const RemovedOnSignal registered(tmp);
   try {
     write(tmp);
   } catch (...) {

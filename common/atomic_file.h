@@ -15,6 +15,22 @@ void write_atomically(const std::string& final_path, const std::function<void(co
 // an interrupted write left a hidden '.NAME.tmpPID.vtu' that nothing removed.
 void remove_temporary_files_on_signals();
 
+// While it lives, `path` is removed by those handlers too: a file unlinked, a folder (kFolder) removed after
+// every registered file, so a temporary folder whose files are registered goes whole. For temporary files
+// that write_atomically does not make (the report's pictures). At most 32 paths at once, each shorter than
+// 4096 bytes; others are not registered (left behind on a signal).
+class RemovedOnSignal {
+ public:
+  enum Kind { kFile, kFolder };
+  explicit RemovedOnSignal(const std::string& path, Kind kind = kFile);
+  ~RemovedOnSignal();
+  RemovedOnSignal(const RemovedOnSignal&) = delete;
+  RemovedOnSignal& operator=(const RemovedOnSignal&) = delete;
+
+ private:
+  int slot_ = -1;
+};
+
 // The temporary name beside `final_path` that its content is written to first: hidden, with the process id,
 // ending in `extension` (the format's, ".vtu" or ".nii.gz": some writers choose the format from it). The
 // final name's stem is shortened when the temporary name would be longer than the folder's file system

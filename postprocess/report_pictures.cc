@@ -9,8 +9,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <vector>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "postprocess/render.h"
 #include "postprocess/report_format.h"
@@ -37,6 +40,8 @@ class TemporaryFolder {
       throw RunError("cannot make a temporary folder for the report's pictures in '" + base.string() + "' (" +
                      std::strerror(errno) + ")" + fix);
     path_ = name;
+    // Ctrl-C or SIGTERM during the rendering left the folder and its pictures behind (helper P).
+    guards_.push_back(std::make_unique<RemovedOnSignal>(path_, RemovedOnSignal::kFolder));
   }
   ~TemporaryFolder() {
     std::error_code ignored;
@@ -44,10 +49,16 @@ class TemporaryFolder {
   }
   TemporaryFolder(const TemporaryFolder&) = delete;
   TemporaryFolder& operator=(const TemporaryFolder&) = delete;
-  const std::string& path() const { return path_; }
+  // The path of a file `name` in the folder, removed with it also on a signal.
+  std::string file(const std::string& name) {
+    const std::string path = path_ + "/" + name;
+    guards_.push_back(std::make_unique<RemovedOnSignal>(path));
+    return path;
+  }
 
  private:
   std::string path_;
+  std::vector<std::unique_ptr<RemovedOnSignal>> guards_;
 };
 
 std::string read_bytes(const std::string& path) {
@@ -109,7 +120,7 @@ std::vector<ReportPicture> render_report_pictures(const std::string& solution_vt
     options.width = 1200;
     options.height = 800;
     options.colour_max = s.colour_max;
-    const std::string png = folder.path() + "/" + s.field + "_" + s.view + ".png";
+    const std::string png = folder.file(s.field + "_" + s.view + ".png");
     const RenderedMesh drawn = render_mesh_png(solution_vtu, s.field, png, options);
     check_same_run(solution_vtu, drawn, s.field, l);
     pictures.push_back({s.field, s.view, s.caption, read_bytes(png)});

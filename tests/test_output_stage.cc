@@ -47,6 +47,28 @@ TEST(AtomicFile, ASignalDuringAWriteRemovesTheTemporaryFile) {
   }
 }
 
+// The report's temporary folder of pictures was left behind on Ctrl-C or SIGTERM (helper P): a registered
+// folder goes with its registered files.
+TEST(AtomicFile, ASignalRemovesARegisteredFolderWithItsFiles) {
+  const std::string dir = test::temp_dir();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    remove_temporary_files_on_signals();
+    fs::create_directory(dir + "/pictures");
+    const RemovedOnSignal folder(dir + "/pictures", RemovedOnSignal::kFolder);
+    const RemovedOnSignal a(dir + "/pictures/a.png"), b(dir + "/pictures/b.png");
+    test::write_file(dir + "/pictures/a.png", "png");
+    test::write_file(dir + "/pictures/b.png", "png");
+    std::raise(SIGTERM);
+    std::_Exit(0);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM);
+  EXPECT_TRUE(fs::is_empty(dir)) << "the folder or a picture was left";
+}
+
 TEST(OutputStage, CommitMovesTheSetInAndRemovesTheEarlierRunsOtherOutputs) {
   const std::string dir = test::temp_dir();
   test::write_file(dir + "/out_a", "old a\n");
