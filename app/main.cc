@@ -3,10 +3,15 @@
 // `mpirun -np N hexbite run ...` works; without mpirun the program is a single rank.
 #include <mpi.h>
 
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
+
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <iostream>
 #include <optional>
@@ -29,12 +34,35 @@ namespace {
 // Starting MPI (and with it PETSc, p4est and Trilinos) costs about half a second, which every quick command
 // would pay for nothing: only `run` and `study` call the solver. The main program's own options are all
 // flags, so the first argument that is not an option names the subcommand.
+// Help and the version need no solver either: under a file size limit (ulimit -f) or a TMPDIR where no
+// file can be made, MPI_Init aborted `hexbite run --help` with Open MPI's own text.
 bool command_uses_solver(int argc, char** argv) {
+  bool solver = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (!arg.empty() && arg[0] != '-') return arg == "run" || arg == "study";
+    if (arg == "-h" || arg == "--help" || arg == "--version") return false;
+    if (!solver && !arg.empty() && arg[0] != '-') {
+      if (arg != "run" && arg != "study") return false;
+      solver = true;
+    }
   }
-  return false;
+  return solver;
+}
+
+// Open MPI keeps its session files under TMPDIR: one where no folder can be made ended MPI_Init with a
+// page of "orte_init failed" text and exit 1. Said plainly instead, before MPI starts; an empty text when
+// TMPDIR (or /tmp) is usable.
+std::string unusable_tmpdir() {
+  const char* tmpdir = std::getenv("TMPDIR");
+  const std::string base = tmpdir && *tmpdir ? tmpdir : "/tmp";
+  std::string probe = base + "/.hexbite-probe-XXXXXX";
+  if (mkdtemp(probe.data()) != nullptr) {
+    rmdir(probe.c_str());
+    return "";
+  }
+  return "hexbite: error: no folder can be made in " +
+         (tmpdir && *tmpdir ? "TMPDIR '" + base + "'" : std::string("'/tmp'")) + " (" + std::strerror(errno) +
+         "), where MPI keeps its session files: point TMPDIR at a folder you can write to\n";
 }
 
 // Prints an error's `text` (whole lines) and returns its exit code. Under mpirun every rank reads the same
@@ -146,7 +174,13 @@ int main(int argc, char** argv) {
   std::signal(SIGXFSZ, SIG_IGN);
   hexbite::remove_temporary_files_on_signals();
   std::optional<hexbite::MpiSession> mpi;
-  if (command_uses_solver(argc, argv)) mpi.emplace(argc, argv);
+  if (command_uses_solver(argc, argv)) {
+    if (const std::string problem = unusable_tmpdir(); !problem.empty()) {
+      std::cerr << problem;
+      return hexbite::kExitBadInput;
+    }
+    mpi.emplace(argc, argv);
+  }
   // Only rank 0 reports progress and results; an error met by every rank alike is reported once (report).
   const bool root = hexbite::MpiSession::rank() == 0;
   MPI_Comm errors = MPI_COMM_NULL;

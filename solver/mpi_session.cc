@@ -8,6 +8,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector_memory.h>
+#include <stdlib.h>
 
 namespace hexbite {
 namespace {
@@ -28,6 +29,11 @@ void start(int& argc, char**& argv) {
   // One thread per rank: the solver's assembly is sequential per rank and the machine's cores are
   // better used by MPI ranks than by threads competing with them.
   if (session_count++ > 0) return;
+  // Without a launcher (no mpirun: a singleton) PMIx's shared-memory datastore is not needed, and its files
+  // could not be made under a file size limit (ulimit -f 2000 aborted every `hexbite run` inside MPI_Init,
+  // although a run writes far less): the plain hash store instead, unless the user chose one.
+  if (std::getenv("PMIX_RANK") == nullptr && std::getenv("OMPI_COMM_WORLD_SIZE") == nullptr)
+    setenv("PMIX_MCA_gds", "hash", 0);
   mpi_init = new dealii::Utilities::MPI::MPI_InitFinalize(argc, argv, 1);
   // MPI_InitFinalize's destructor empties deal.II's pools of MPI vectors (function-local statics, created on
   // first use, e.g. by CG). A pool first used after a global MpiSession was built would be destroyed before

@@ -407,6 +407,28 @@ TEST(CliBadInput, AnOutputThatCannotBeCreatedIsNamed) {
   }
 }
 
+// Under a file size limit MPI_Init aborted `run --help` and every run with 16 lines of PMIx errors (exit 1),
+// and a TMPDIR where no folder can be made with "orte_init failed" (helper P). Help needs no MPI, a run
+// under the limit writes what fits, and the TMPDIR is named.
+TEST(Cli, RunAndStudyStartUnderAFileSizeLimitAndNameAnUnusableTmpdir) {
+  const std::vector<std::string> limited = {"bash", "-c", "ulimit -f 2000; exec \"$@\"", "bash"};
+  for (const char* command : {"run", "study"}) {
+    const test::CommandResult help = run_hexbite({command, "--help"}, limited);
+    EXPECT_EQ(help.exit_code, 0) << help.err;
+    EXPECT_NE(help.out.find("Output folder"), std::string::npos) << help.out;
+    EXPECT_EQ(help.err.find("PMIX"), std::string::npos) << help.err;
+  }
+  const std::string dir = temp_dir();
+  test::CommandResult r = run_hexbite({"run", dir + "/none.yaml", "-o", dir + "/out"}, limited);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("cannot read scenario file"), std::string::npos) << r.err;
+  r = run_hexbite({"run", dir + "/none.yaml", "-o", dir + "/out"}, {"env", "TMPDIR=/proc"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err,
+            "hexbite: error: no folder can be made in TMPDIR '/proc' (No such file or directory), where "
+            "MPI keeps its session files: point TMPDIR at a folder you can write to\n");
+}
+
 // Level counts are counts like --target-hexes: `--levels 1.0` was "not in range 0 to 3", an empty value too,
 // and `--levels 0x1` ran one level. Hexadecimal is refused for every count.
 TEST(CliBadInput, LevelCountsAreWholeDecimalNumbers) {
