@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+
 #include "tests/test_util.h"
 
 namespace hexbite {
@@ -722,6 +724,59 @@ TEST(CliBadInput, MistypedCommandIsNamed) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("a command is required before '--units'"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("unknown command"), std::string::npos) << r.err;
+}
+
+// Inputs that are no regular file: a named pipe or /dev/zero was read without end (the memory grew by
+// hundreds of MB a second, or the command hung), and a folder or a pipe got the wrong message ("no such
+// file", "cannot read scenario file", a damaged file). Each reader now says what the input is, at once;
+// `timeout` ends the old behaviour as a failure.
+TEST(CliBadInput, InputsThatAreNoRegularFileAreRefusedAtOnce) {
+  const std::string dir = temp_dir();
+  const std::string cube = dir + "/cube.obj";
+  write_file(cube, cube_obj());
+  ASSERT_EQ(run_hexbite({"-q", "mesh", cube, "--target-hexes", "8", "-o", dir + "/m.vtu"}).exit_code, 0);
+  for (const char* name : {"p.vtu", "p.yaml", "p.mha", "p.stl"})
+    ASSERT_EQ(::mkfifo((dir + "/" + name).c_str(), 0600), 0) << name;
+  for (const char* name : {"z.msh", "z.yaml", "z.mha"}) fs::create_symlink("/dev/zero", dir + "/" + name);
+  fs::create_directories(dir + "/rz");
+  fs::create_symlink("/dev/zero", dir + "/rz/results.json");
+  for (const char* name : {"d.vtu", "d.yaml"}) fs::create_directories(dir + "/" + name);
+  const std::string fifo = "is a named pipe (a FIFO, or a shell's <(...)), not a regular file";
+  const std::string device = "is a device, not a regular file: give a file";
+  const std::string folder = "is a folder, not a file: give a file";
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::string out = dir + "/out";
+  const std::vector<Case> cases = {
+      {{"quality", dir + "/p.vtu"}, "hex mesh file '" + dir + "/p.vtu' " + fifo},
+      {{"quality", dir + "/z.msh"}, "Gmsh mesh file '" + dir + "/z.msh' " + device},
+      {{"refine", dir + "/z.msh", "-o", out + ".vtu"}, device},
+      {{"reorder", dir + "/p.vtu", "-o", out + ".vtu"}, fifo},
+      {{"run", dir + "/p.yaml", "-o", out}, "scenario file '" + dir + "/p.yaml' " + fifo},
+      {{"run", dir + "/z.yaml", "-o", out}, device},
+      {{"run", dir + "/d.yaml", "-o", out}, "scenario file '" + dir + "/d.yaml' " + folder},
+      {{"study", dir + "/p.yaml", "-o", out}, "study file '" + dir + "/p.yaml' " + fifo},
+      {{"study", dir + "/z.yaml", "-o", out}, device},
+      {{"report", dir + "/rz", "-o", out + ".html", "--no-pictures"},
+       "results file '" + dir + "/rz/results.json' " + device},
+      {{"reorder", dir + "/m.vtu", "--landmarks", dir + "/p.yaml", "-o", out + ".vtu"},
+       "landmark file '" + dir + "/p.yaml' " + fifo},
+      {{"mesh", cube, "--landmarks", dir + "/p.yaml", "-o", out + ".vtu"}, fifo},
+      {{"quad", "from-mandible", cube, "--landmarks", dir + "/p.yaml", "-o", out + ".obj"}, fifo},
+      {{"surface", "from-ct", dir + "/z.mha", "--threshold", "600", "-o", out + ".stl"},
+       "volume file '" + dir + "/z.mha' " + device},
+      {{"surface", "from-ct", dir + "/p.mha", "--threshold", "600", "-o", out + ".stl"}, fifo},
+      {{"surface", "check", dir + "/p.stl"}, "surface file '" + dir + "/p.stl' " + fifo},
+      {{"render", dir + "/d.vtu", "-o", out + ".png"}, "mesh file '" + dir + "/d.vtu' " + folder},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args, {"timeout", "20"});
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << c.args[1] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.args[0] << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace
