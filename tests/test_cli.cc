@@ -779,5 +779,34 @@ TEST(CliBadInput, InputsThatAreNoRegularFileAreRefusedAtOnce) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// An output path with a file where a folder is needed said "folder 'm.vtu' does not exist; create it
+// first", and a path longer than the system takes (PATH_MAX) said the folder does not exist, or failed after
+// the whole run ("File name too long"): both are named when the command line is read.
+TEST(CliBadInput, OutputPathsThroughAFileOrTooLongAreNamed) {
+  const std::string dir = temp_dir();
+  const std::string cube = dir + "/cube.obj";
+  write_file(cube, cube_obj());
+  std::string deep = dir;
+  for (int i = 0; i < 20; ++i) deep += "/" + std::string(240, 'd');
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"reorder", dir + "/m.vtu", "-o", cube + "/x.vtu"}, "'" + cube + "' is a file, not a folder"},
+      {{"mesh", cube, "-o", cube + "/sub/m.vtu"}, "'" + cube + "' is a file, not a folder"},
+      {{"generate", "mandible", "-o", cube + "/g.stl"}, "'" + cube + "' is a file, not a folder"},
+      {{"reorder", dir + "/m.vtu", "-o", deep + "/x.vtu"}, "a path may have (PATH_MAX): give a shorter path"},
+      {{"run", "scenario.yaml", "-o", deep}, "a path may have (PATH_MAX): give a shorter path"},
+      {{"generate", "mandible", "-o", dir + "/g.stl", "--dicom", deep}, "(PATH_MAX)"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("does not exist"), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace
 }  // namespace hexbite
