@@ -726,6 +726,41 @@ TEST(CliBadInput, MistypedCommandIsNamed) {
   EXPECT_EQ(r.err.find("unknown command"), std::string::npos) << r.err;
 }
 
+// --help after a mistyped command printed the top-level help, exit 0, as if the command existed; the help
+// of a command that exists, and of a level without its command, is still printed.
+TEST(CliBadInput, MistypedCommandIsNamedWithHelpToo) {
+  auto r = run_hexbite({"rnu", "--help"});
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("unknown command 'rnu'; the commands are: surface,"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  r = run_hexbite({"surface", "nosuch", "--help"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown command 'surface nosuch'"), std::string::npos) << r.err;
+  for (const std::vector<std::string>& args :
+       std::vector<std::vector<std::string>>{{"--help"}, {"surface", "--help"}, {"run", "--help"}}) {
+    r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 0) << args.front() << "\n" << r.err;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
+  }
+}
+
+// A file whose name starts with '-' was read as an option: "MESH is required". The message names the file
+// and how to give it; the same word that is no file is still an unknown option.
+TEST(CliBadInput, AFileNamedLikeAnOptionIsNamed) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/-m.vtu", "x");
+  const std::vector<std::string> in_dir = {"bash", "-c", "cd \"$0\" && exec \"$@\"", dir};
+  auto r = run_hexbite({"quality", "-m.vtu"}, in_dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("'-m.vtu' was read as an option, but it is a file: give it as './-m.vtu', or put "
+                       "'--' before it"),
+            std::string::npos)
+      << r.err;
+  r = run_hexbite({"quality", "-n.vtu"}, in_dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.find("was read as an option"), std::string::npos) << r.err;
+}
+
 // Inputs that are no regular file: a named pipe or /dev/zero was read without end (the memory grew by
 // hundreds of MB a second, or the command hung), and a folder or a pipe got the wrong message ("no such
 // file", "cannot read scenario file", a damaged file). Each reader now says what the input is, at once;
