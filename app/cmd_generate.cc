@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/commands.h"
 #include "app/option_checks.h"
@@ -119,6 +120,35 @@ bool is_series_slice(const std::string& name) {
          std::all_of(name.begin() + 3, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
 }
 
+// Two outputs of one path (`-o jaw.stl --dicom jaw.stl`), or the DICOM folder inside another output's path,
+// failed only when the files were moved in, after the work ("a folder of that name is in the way", exit 1).
+// The paths are compared as the system would resolve them (links, "./", a trailing "/").
+struct NamedOutput {
+  std::string option, path;
+  bool folder = false;  // --dicom: the other outputs may lie in it
+};
+
+void require_distinct_outputs(const std::vector<NamedOutput>& outputs) {
+  const auto resolved = [](const std::string& path) {
+    std::error_code ec;
+    fs::path p = fs::weakly_canonical(fs::absolute(path), ec);
+    if (ec) p = fs::absolute(path).lexically_normal();
+    return p.has_filename() ? p : p.parent_path();  // "ct/" is "ct"
+  };
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < outputs.size(); ++j) {
+      if (i == j) continue;
+      const fs::path a = resolved(outputs[i].path), b = resolved(outputs[j].path);
+      const std::string both = outputs[i].option + " '" + outputs[i].path + "' and " + outputs[j].option +
+                               " '" + outputs[j].path + "'";
+      if (i < j && a == b) throw InputError(both + " are the same path; give each output its own name");
+      const fs::path inside = b.lexically_relative(a);
+      if (!outputs[i].folder && a != b && !inside.empty() && *inside.begin() != "..")
+        throw InputError(both + ": the second lies inside the first, which is a file; give each output " +
+                         "its own place");
+    }
+}
+
 void run_generate(const GenerateArgs& args) {
   MandibleParameters params = args.parameters;
   params.variant = parse_variant(args.variant);
@@ -135,6 +165,13 @@ void run_generate(const GenerateArgs& args) {
       throw InputError(problem +
                        " (the landmark file's default name, from -o); give --landmarks another path");
   }
+  std::vector<NamedOutput> named = {
+      {"-o", args.output},
+      {args.landmarks.empty() ? "the landmark file (its default name, from -o)" : "--landmarks",
+       landmark_path}};
+  if (!args.ct.empty()) named.push_back({"--ct", args.ct});
+  if (!args.dicom.empty()) named.push_back({"--dicom", args.dicom, true});
+  require_distinct_outputs(named);
 
   const auto start = std::chrono::steady_clock::now();
   Progress progress("generate mandible");
