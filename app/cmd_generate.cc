@@ -77,15 +77,21 @@ class GenerateOutputs {
     guarded(stage, [&] { write(stage.stage_dir()); });
   }
 
-  // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself).
+  // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself). Every
+  // folder is checked before the first is moved in: a folder in the way of a DICOM slice's name failed the
+  // DICOM folder's commit after the surface, landmarks and CT were in place, replacing the earlier ones.
   void commit() {
-    for (const std::unique_ptr<OutputStage>& stage : stages_) {
-      std::vector<std::string> files;
-      for (const fs::directory_entry& entry : fs::directory_iterator(stage->stage_dir()))
-        if (entry.is_regular_file()) files.push_back(entry.path().filename().string());
-      std::sort(files.begin(), files.end());
-      const auto retire = retire_.find(stage.get());
-      stage->commit(files, retire == retire_.end() ? nullptr : retire->second);
+    std::vector<std::vector<std::string>> files(stages_.size());
+    for (std::size_t i = 0; i < stages_.size(); ++i) {
+      for (const fs::directory_entry& entry : fs::directory_iterator(stages_[i]->stage_dir()))
+        if (entry.is_regular_file()) files[i].push_back(entry.path().filename().string());
+      std::sort(files[i].begin(), files[i].end());
+      const std::string why = stages_[i]->blocked(files[i]);
+      if (!why.empty()) throw RunError(why + kKept);
+    }
+    for (std::size_t i = 0; i < stages_.size(); ++i) {
+      const auto retire = retire_.find(stages_[i].get());
+      stages_[i]->commit(files[i], retire == retire_.end() ? nullptr : retire->second);
     }
   }
 
@@ -100,15 +106,17 @@ class GenerateOutputs {
 
   // Runs `write`; its error names the file by its place in the output folder, and says nothing was written.
   static void guarded(const OutputStage& stage, const std::function<void()>& write) {
-    const std::string kept = "; none of the outputs was written (files of those names are as they were)";
     try {
       write();
     } catch (const InputError& e) {
-      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kKept);
     } catch (const std::exception& e) {
-      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kKept);
     }
   }
+
+  static constexpr const char* kKept =
+      "; none of the outputs was written (files of those names are as they were)";
 
   std::vector<std::unique_ptr<OutputStage>> stages_;  // one per output folder; uncommitted ones discarded
   std::map<const OutputStage*, std::function<bool(const std::string&)>> retire_;

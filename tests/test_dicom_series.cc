@@ -448,5 +448,24 @@ TEST(DicomSeries, GenerateRefusesTwoOutputsOfOnePath) {
   }
 }
 
+// A folder in the way of a slice's name failed the DICOM folder's commit after the surface, landmarks and
+// CT had been moved in (the earlier jaw.stl replaced); every folder is now checked before the first move.
+TEST(DicomSeries, GenerateLeavesEarlierFilesWhenTheSeriesCannotBeMovedInAndKeepsTheUsersFiles) {
+  const std::string dir = test::temp_dir();
+  fs::create_directories(dir + "/ct/ct_0005.dcm");
+  test::write_file(dir + "/jaw.stl", "OLD\n");
+  const std::map<std::string, std::string> before = test::files_under(dir);
+  const std::vector<std::string> generate = {
+      "-q",      "generate", "mandible", "-o",       dir + "/jaw.stl", "--ct", dir + "/jaw.mha",
+      "--voxel", "1.5",      "--dicom",  dir + "/ct"};
+  auto r = test::run_hexbite(generate);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write '" + dir + "/ct/ct_0005.dcm': a folder of that name is in the way"),
+            std::string::npos)
+      << r.err;
+  test::expect_same_files(before, test::files_under(dir));
+
+}
+
 }  // namespace
 }  // namespace hexbite
