@@ -122,10 +122,13 @@ class GenerateOutputs {
   std::map<const OutputStage*, std::function<bool(const std::string&)>> retire_;
 };
 
-// The slice files of a series that write_dicom_series wrote: ct_0001.dcm, ct_0002.dcm, ...
-bool is_series_slice(const std::string& name) {
+// The slice files of a series that write_dicom_series wrote into `dir`: ct_0001.dcm, ct_0002.dcm, ...,
+// each a DICOM file. A file of such a name that is no DICOM file (the user's notes) was never written by
+// hexbite, and an earlier series' retirement must not remove it.
+bool is_series_slice(const std::string& dir, const std::string& name) {
   return name.size() == 11 && name.compare(0, 3, "ct_") == 0 && name.compare(7, 4, ".dcm") == 0 &&
-         std::all_of(name.begin() + 3, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
+         std::all_of(name.begin() + 3, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; }) &&
+         has_dicom_preamble((fs::path(dir) / name).string());
 }
 
 // Two outputs of one path (`-o jaw.stl --dicom jaw.stl`), or the DICOM folder inside another output's path,
@@ -195,7 +198,8 @@ void run_generate(const GenerateArgs& args) {
   if (!args.ct.empty()) outputs.write(args.ct, [&](const std::string& p) { write_volume(p, jaw.ct); });
   if (!args.dicom.empty())
     outputs.write_folder(
-        args.dicom, [&](const std::string& dir) { write_dicom_series(dir, jaw.ct); }, is_series_slice);
+        args.dicom, [&](const std::string& dir) { write_dicom_series(dir, jaw.ct); },
+        [&](const std::string& name) { return is_series_slice(args.dicom, name); });
   outputs.commit();
 
   Vec3 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),

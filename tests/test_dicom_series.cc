@@ -450,6 +450,8 @@ TEST(DicomSeries, GenerateRefusesTwoOutputsOfOnePath) {
 
 // A folder in the way of a slice's name failed the DICOM folder's commit after the surface, landmarks and
 // CT had been moved in (the earlier jaw.stl replaced); every folder is now checked before the first move.
+// And a file of a slice's name that is no DICOM file (ct_9999.dcm of text) is the user's: an earlier series'
+// retirement removed it.
 TEST(DicomSeries, GenerateLeavesEarlierFilesWhenTheSeriesCannotBeMovedInAndKeepsTheUsersFiles) {
   const std::string dir = test::temp_dir();
   fs::create_directories(dir + "/ct/ct_0005.dcm");
@@ -465,6 +467,15 @@ TEST(DicomSeries, GenerateLeavesEarlierFilesWhenTheSeriesCannotBeMovedInAndKeeps
       << r.err;
   test::expect_same_files(before, test::files_under(dir));
 
+  fs::remove(dir + "/ct/ct_0005.dcm");
+  test::write_file(dir + "/ct/ct_9999.dcm", "my notes\n");
+  r = test::run_hexbite(generate);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  fs::copy_file(dir + "/ct/ct_0001.dcm", dir + "/ct/ct_9998.dcm");  // a slice of a longer, earlier series
+  r = test::run_hexbite(generate);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(test::read_file(dir + "/ct/ct_9999.dcm"), "my notes\n");
+  EXPECT_FALSE(fs::exists(dir + "/ct/ct_9998.dcm"));
 }
 
 }  // namespace
