@@ -423,8 +423,10 @@ void broadcast(std::string* text, int root) {
 }  // namespace
 
 bool is_earlier_run_output(const std::string& dir, const std::string& name) {
+  // Levels 1 to 3 only (run --levels, mesh.validation_levels): a solution_level4.vtu was never written by
+  // a run, so it is the user's and stays.
   static const std::regex kOutputName(
-      R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[0-9]+)?(\.pvtu|(_[0-9]+)?\.vtu)))");
+      R"((mesh\.vtu|model(_mesh)?\.inp|solution(_level[1-3])?(\.pvtu|(_[0-9]+)?\.vtu)))");
   const std::filesystem::path path = std::filesystem::path(dir) / name;
   std::error_code ec;
   return std::regex_match(path.filename().string(), kOutputName) &&
