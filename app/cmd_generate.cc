@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/commands.h"
 #include "app/option_checks.h"
@@ -76,15 +77,21 @@ class GenerateOutputs {
     guarded(stage, [&] { write(stage.stage_dir()); });
   }
 
-  // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself).
+  // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself). Every
+  // folder is checked before the first is moved in: a folder in the way of a DICOM slice's name failed the
+  // DICOM folder's commit after the surface, landmarks and CT were in place, replacing the earlier ones.
   void commit() {
-    for (const std::unique_ptr<OutputStage>& stage : stages_) {
-      std::vector<std::string> files;
-      for (const fs::directory_entry& entry : fs::directory_iterator(stage->stage_dir()))
-        if (entry.is_regular_file()) files.push_back(entry.path().filename().string());
-      std::sort(files.begin(), files.end());
-      const auto retire = retire_.find(stage.get());
-      stage->commit(files, retire == retire_.end() ? nullptr : retire->second);
+    std::vector<std::vector<std::string>> files(stages_.size());
+    for (std::size_t i = 0; i < stages_.size(); ++i) {
+      for (const fs::directory_entry& entry : fs::directory_iterator(stages_[i]->stage_dir()))
+        if (entry.is_regular_file()) files[i].push_back(entry.path().filename().string());
+      std::sort(files[i].begin(), files[i].end());
+      const std::string why = stages_[i]->blocked(files[i]);
+      if (!why.empty()) throw RunError(why + kKept);
+    }
+    for (std::size_t i = 0; i < stages_.size(); ++i) {
+      const auto retire = retire_.find(stages_[i].get());
+      stages_[i]->commit(files[i], retire == retire_.end() ? nullptr : retire->second);
     }
   }
 
@@ -99,24 +106,58 @@ class GenerateOutputs {
 
   // Runs `write`; its error names the file by its place in the output folder, and says nothing was written.
   static void guarded(const OutputStage& stage, const std::function<void()>& write) {
-    const std::string kept = "; none of the outputs was written (files of those names are as they were)";
     try {
       write();
     } catch (const InputError& e) {
-      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+      throw InputError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kKept);
     } catch (const std::exception& e) {
-      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kept);
+      throw RunError(named_in_dir(e.what(), stage.stage_dir(), stage.dir()) + kKept);
     }
   }
+
+  static constexpr const char* kKept =
+      "; none of the outputs was written (files of those names are as they were)";
 
   std::vector<std::unique_ptr<OutputStage>> stages_;  // one per output folder; uncommitted ones discarded
   std::map<const OutputStage*, std::function<bool(const std::string&)>> retire_;
 };
 
-// The slice files of a series that write_dicom_series wrote: ct_0001.dcm, ct_0002.dcm, ...
-bool is_series_slice(const std::string& name) {
+// The slice files of a series that write_dicom_series wrote into `dir`: ct_0001.dcm, ct_0002.dcm, ...,
+// each a DICOM file. A file of such a name that is no DICOM file (the user's notes) was never written by
+// hexbite, and an earlier series' retirement must not remove it.
+bool is_series_slice(const std::string& dir, const std::string& name) {
   return name.size() == 11 && name.compare(0, 3, "ct_") == 0 && name.compare(7, 4, ".dcm") == 0 &&
-         std::all_of(name.begin() + 3, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; });
+         std::all_of(name.begin() + 3, name.begin() + 7, [](char c) { return c >= '0' && c <= '9'; }) &&
+         has_dicom_preamble((fs::path(dir) / name).string());
+}
+
+// Two outputs of one path (`-o jaw.stl --dicom jaw.stl`), or the DICOM folder inside another output's path,
+// failed only when the files were moved in, after the work ("a folder of that name is in the way", exit 1).
+// The paths are compared as the system would resolve them (links, "./", a trailing "/").
+struct NamedOutput {
+  std::string option, path;
+  bool folder = false;  // --dicom: the other outputs may lie in it
+};
+
+void require_distinct_outputs(const std::vector<NamedOutput>& outputs) {
+  const auto resolved = [](const std::string& path) {
+    std::error_code ec;
+    fs::path p = fs::weakly_canonical(fs::absolute(path), ec);
+    if (ec) p = fs::absolute(path).lexically_normal();
+    return p.has_filename() ? p : p.parent_path();  // "ct/" is "ct"
+  };
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < outputs.size(); ++j) {
+      if (i == j) continue;
+      const fs::path a = resolved(outputs[i].path), b = resolved(outputs[j].path);
+      const std::string both = outputs[i].option + " '" + outputs[i].path + "' and " + outputs[j].option +
+                               " '" + outputs[j].path + "'";
+      if (i < j && a == b) throw InputError(both + " are the same path; give each output its own name");
+      const fs::path inside = b.lexically_relative(a);
+      if (!outputs[i].folder && a != b && !inside.empty() && *inside.begin() != "..")
+        throw InputError(both + ": the second lies inside the first, which is a file; give each output " +
+                         "its own place");
+    }
 }
 
 void run_generate(const GenerateArgs& args) {
@@ -135,6 +176,13 @@ void run_generate(const GenerateArgs& args) {
       throw InputError(problem +
                        " (the landmark file's default name, from -o); give --landmarks another path");
   }
+  std::vector<NamedOutput> named = {
+      {"-o", args.output},
+      {args.landmarks.empty() ? "the landmark file (its default name, from -o)" : "--landmarks",
+       landmark_path}};
+  if (!args.ct.empty()) named.push_back({"--ct", args.ct});
+  if (!args.dicom.empty()) named.push_back({"--dicom", args.dicom, true});
+  require_distinct_outputs(named);
 
   const auto start = std::chrono::steady_clock::now();
   Progress progress("generate mandible");
@@ -150,7 +198,8 @@ void run_generate(const GenerateArgs& args) {
   if (!args.ct.empty()) outputs.write(args.ct, [&](const std::string& p) { write_volume(p, jaw.ct); });
   if (!args.dicom.empty())
     outputs.write_folder(
-        args.dicom, [&](const std::string& dir) { write_dicom_series(dir, jaw.ct); }, is_series_slice);
+        args.dicom, [&](const std::string& dir) { write_dicom_series(dir, jaw.ct); },
+        [&](const std::string& name) { return is_series_slice(args.dicom, name); });
   outputs.commit();
 
   Vec3 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),

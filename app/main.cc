@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <optional>
@@ -130,7 +131,9 @@ std::optional<std::string> repeated_option_message(const CLI::App& app) {
 // A command level that needs a command and was given none (CLI11 says only "A subcommand is required",
 // also when the word given is a typo): the message names the word left over, if any, and lists the
 // commands of that level with where to read about them. nullopt when the missing piece is something else.
-std::optional<std::string> missing_command_message(const CLI::App& app) {
+// With `mistyped_only`, only a plain word left over (a mistyped command) gives a message: --help printed the
+// help of the level above a typo (`hexbite rnu --help`) with exit 0, as if the command existed.
+std::optional<std::string> missing_command_message(const CLI::App& app, bool mistyped_only = false) {
   const CLI::App* level = &app;
   std::string chosen;  // the commands given, "surface " for `hexbite surface nosuch`
   for (auto given = app.get_subcommands(); !given.empty(); given = level->get_subcommands()) {
@@ -147,10 +150,27 @@ std::optional<std::string> missing_command_message(const CLI::App& app) {
   // --units m`: 'm' is its value, not a command), a plain word is a mistyped command.
   for (const std::string& word : app.remaining(true)) {
     if (word.empty()) continue;
-    if (word[0] == '-') return "a command is required before '" + word + "'; " + list;
+    if (word[0] == '-') {
+      if (mistyped_only) return std::nullopt;
+      return "a command is required before '" + word + "'; " + list;
+    }
     return "unknown command '" + chosen + word + "'; " + list;
   }
+  if (mistyped_only) return std::nullopt;
   return "a command is required; " + list;
+}
+
+// A file whose name starts with '-' (`hexbite quality -m.vtu`) is read as an option, and CLI11 then says
+// only that the file's argument is required: the message names the file and how to give it. nullopt when
+// no word left over is an existing file.
+std::optional<std::string> file_read_as_option_message(const CLI::App& app) {
+  for (const std::string& word : app.remaining(true)) {
+    std::error_code ec;
+    if (word.size() > 1 && word[0] == '-' && std::filesystem::exists(word, ec))
+      return "'" + word + "' was read as an option, but it is a file: give it as './" + word +
+             "', or put '--' before it (no option after '--' is read as one)";
+  }
+  return std::nullopt;
 }
 
 // Standard output holds what a script reads (`--json`, the tables, --help): when it could not be written
@@ -211,6 +231,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    if (const std::optional<std::string> mistyped = missing_command_message(app, true))
+      return report("hexbite: error: " + *mistyped + '\n', hexbite::kExitBadInput, errors);
     return checked_stdout(app.exit(e));
   } catch (const CLI::CallForAllHelp& e) {
     return checked_stdout(app.exit(e));
@@ -225,10 +247,14 @@ int main(int argc, char** argv) {
   } catch (const CLI::RequiredError& e) {
     if (const std::optional<std::string> missing = missing_command_message(app))
       return report("hexbite: error: " + *missing + '\n', hexbite::kExitBadInput, errors);
+    if (const std::optional<std::string> file = file_read_as_option_message(app))
+      return report("hexbite: error: " + *file + '\n', hexbite::kExitBadInput, errors);
     std::ostringstream text;
     app.exit(e, text, text);
     return report(text.str(), hexbite::kExitBadInput, errors);
   } catch (const CLI::ParseError& e) {
+    if (const std::optional<std::string> file = file_read_as_option_message(app))
+      return report("hexbite: error: " + *file + '\n', hexbite::kExitBadInput, errors);
     std::ostringstream text;
     app.exit(e, text, text);  // the message and a hint to --help
     return report(text.str(), hexbite::kExitBadInput, errors);

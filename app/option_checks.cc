@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -76,6 +77,35 @@ std::string name_too_long(const fs::path& existing, const fs::path& path) {
   return {};
 }
 
+// Why `value` is longer than the system takes for a path (PATH_MAX, with its closing NUL), with the `added`
+// bytes of names that hexbite puts in or beside it, or empty. The checks below would take such a path for a
+// missing folder (every call on it fails), and a run found it only when it wrote its outputs, after the work.
+std::string path_too_long(const std::string& value, std::size_t added) {
+  if (value.size() + added < PATH_MAX) return {};
+  const std::size_t shown = 60;
+  return "the path '" + (value.size() > shown ? value.substr(0, shown) + "..." : value) + "' is " +
+         thousands(long(value.size())) + " bytes long; with the " + std::to_string(added) +
+         " bytes of the names hexbite writes in it, that is more than the " + thousands(PATH_MAX - 1) +
+         " a path may have (PATH_MAX): give a shorter path";
+}
+
+// The deepest part of `path` that exists ("." when none does), or a link on it whose target does not exist
+// (or a loop of links), which the caller names.
+fs::path deepest_existing(fs::path path) {
+  std::error_code ec;
+  while (!fs::exists(path, ec)) {
+    if (fs::is_symlink(fs::symlink_status(path, ec))) return path;
+    path = path.parent_path();
+    if (path.empty()) return ".";
+  }
+  return path;
+}
+
+// "'a.stl' is a file, not a folder; ": for a file where an output's path needs a folder.
+std::string file_not_folder(const fs::path& file) {
+  return "'" + file.string() + "' is a file, not a folder; ";
+}
+
 }  // namespace
 
 CLI::Validator count_in_range(long lo, long hi) {
@@ -105,15 +135,23 @@ CLI::Validator number_in_range(double lo, double hi, const std::string& range) {
 CLI::Validator output_file(std::vector<std::string> extensions) {
   return CLI::Validator(
       [extensions](std::string& value) -> std::string {
+        // The temporary file beside the output: "." + name + ".tmp" + a process id.
+        const std::string too_long = path_too_long(value, 16);
+        if (!too_long.empty()) return "cannot write: " + too_long;
         const fs::path path(value);
         std::error_code ec;
         if (fs::is_directory(path, ec))
           return "'" + value + "' is a folder: give a file name in it, e.g. '" + (path / "out").string() +
                  extensions.front() + "'";
         const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-        if (!fs::is_directory(dir, ec))
+        if (!fs::is_directory(dir, ec)) {
+          const fs::path existing = deepest_existing(dir);
+          if (fs::exists(existing, ec) && !fs::is_directory(existing, ec))
+            return "cannot write '" + value + "': " + file_not_folder(existing) +
+                   "give a path in a folder (or a new folder, created first)";
           return "cannot write '" + value + "': folder '" + dir.string() +
                  "' does not exist; create it first";
+        }
         const std::string name = lower(path.filename().string());
         for (const std::string& ext : extensions)
           if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0) {
@@ -145,29 +183,25 @@ CLI::Validator output_folder() {
       [](std::string& value) -> std::string {
         const std::string give = "give a folder for the outputs (it is created if missing)";
         if (value.empty()) return "the output folder is an empty name: " + give;
+        // The stage folder (".hexbite-stage-XXXXXX") and the names of the files in it, the longest a study's
+        // "<variant>/solution_level3.vtu".
+        const std::string too_long = path_too_long(value, 64);
+        if (!too_long.empty()) return "cannot create the output folder: " + too_long;
         std::error_code ec;
         if (fs::exists(value, ec) && !fs::is_directory(value, ec))
           return "'" + value + "' is a file, not a folder: " + give;
         // A missing folder is created after the work; a file where a folder of its path should be, or a
         // folder that takes no new entries (a read-only file system, /proc), would only be found then, so
         // the path's deepest existing part is looked at now.
-        fs::path existing = value;
-        while (!fs::exists(existing, ec)) {
-          // A dangling link (or a loop of links) on the path was found only when the folder was made,
-          // after the whole run: "cannot create the output folder 'dl': File exists", exit 1.
-          if (fs::is_symlink(fs::symlink_status(existing, ec)))
-            return "cannot create the output folder '" + value + "': '" + existing.string() +
-                   "' is a link to '" + fs::read_symlink(existing, ec).string() +
-                   "', which does not exist or loops; remove the link, point it at a folder, or " + give;
-          existing = existing.parent_path();
-          if (existing.empty()) {
-            existing = ".";
-            break;
-          }
-        }
-        if (!fs::is_directory(existing, ec))
+        const fs::path existing = deepest_existing(value);
+        // A dangling link (or a loop of links) on the path was found only when the folder was made, after
+        // the whole run: "cannot create the output folder 'dl': File exists", exit 1.
+        if (!fs::exists(existing, ec))
           return "cannot create the output folder '" + value + "': '" + existing.string() +
-                 "' is a file, not a folder; " + give;
+                 "' is a link to '" + fs::read_symlink(existing, ec).string() +
+                 "', which does not exist or loops; remove the link, point it at a folder, or " + give;
+        if (!fs::is_directory(existing, ec))
+          return "cannot create the output folder '" + value + "': " + file_not_folder(existing) + give;
         const std::string long_name = name_too_long(existing, value);
         if (!long_name.empty()) return "cannot create the output folder '" + value + "': " + long_name;
         const std::string refused = cannot_make_entries(existing);

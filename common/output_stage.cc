@@ -110,6 +110,24 @@ void OutputStage::unlock() noexcept {
   lock_ = -1;
 }
 
+std::string OutputStage::blocked(const std::vector<std::string>& files) const {
+  const fs::path dir(dir_);
+  std::error_code ec;
+  for (const std::string& name : files) {
+    const fs::path target = dir / name;
+    for (fs::path p = fs::path(name).parent_path(); !p.empty(); p = p.parent_path()) {
+      const fs::file_status status = fs::symlink_status(dir / p, ec);
+      if (fs::exists(status) && !fs::is_directory(status))
+        return "cannot write '" + target.string() + "': '" + (dir / p).string() +
+               "' is a file, not a folder; remove or rename it, or choose another output folder";
+    }
+    if (fs::is_directory(fs::symlink_status(target, ec)))
+      return "cannot write '" + target.string() +
+             "': a folder of that name is in the way; remove or rename it, or choose another output folder";
+  }
+  return {};
+}
+
 void OutputStage::commit(const std::vector<std::string>& files,
                          const std::function<bool(const std::string&)>& retire) {
   const fs::path dir(dir_), stage(stage_), previous = fs::path(stage_) / ".previous";
@@ -132,6 +150,8 @@ void OutputStage::commit(const std::vector<std::string>& files,
     for (fs::path p = fs::path(name).parent_path(); !p.empty(); p = p.parent_path())
       folders.insert(p.string());
   try {
+    const std::string why = blocked(files);
+    if (!why.empty()) throw RunError(why);
     std::error_code ec;
     fs::create_directory(previous, ec);
     if (ec) throw RunError("cannot write in the output folder '" + dir_ + "': " + ec.message());
@@ -163,21 +183,12 @@ void OutputStage::commit(const std::vector<std::string>& files,
       std::vector<fs::path> above;
       for (fs::path p = fs::path(name).parent_path(); !p.empty(); p = p.parent_path()) above.push_back(p);
       for (auto p = above.rbegin(); p != above.rend(); ++p) {
-        const fs::file_status status = fs::symlink_status(dir / *p, ec);
-        if (fs::is_directory(status)) continue;
-        if (fs::exists(status))
-          throw RunError("cannot write '" + target.string() + "': '" + (dir / *p).string() +
-                         "' is a file, not a folder; remove or rename it, or choose another output folder");
+        if (fs::is_directory(fs::symlink_status(dir / *p, ec))) continue;
         fs::create_directory(dir / *p, ec);
         if (ec) throw RunError("cannot write '" + target.string() + "': " + ec.message());
         done.push_back({fs::path(), dir / *p});
       }
-      const fs::file_status old = fs::symlink_status(target, ec);
-      if (fs::is_directory(old))
-        throw RunError("cannot write '" + target.string() +
-                       "': a folder of that name is in the way; remove or rename it, or choose another "
-                       "output folder");
-      if (fs::exists(old)) move(target, previous / name, target);
+      if (fs::exists(fs::symlink_status(target, ec))) move(target, previous / name, target);
       move(staged, target, target);
     }
   } catch (const std::exception& e) {

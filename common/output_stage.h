@@ -49,6 +49,12 @@ class OutputStage {
   void commit(const std::vector<std::string>& files,
               const std::function<bool(const std::string&)>& retire = nullptr);
 
+  // Why commit(files) would fail for what is in the output folder now (a folder in the way of a file's
+  // name, a file where a folder of its path is needed), or empty. commit() asks it before the first move;
+  // a command that commits several stages asks every one before the first commit, so that a later stage
+  // that cannot be moved in does not leave the earlier ones' files in place.
+  std::string blocked(const std::vector<std::string>& files) const;
+
   // Removes the stage and the folders the constructor created (these only when empty). Never throws.
   void discard() noexcept;
 

@@ -19,4 +19,10 @@ std::string quoted(const std::string& path);
 // and 255 when it does not say).
 std::size_t longest_name_in(const std::string& dir);
 
+// Throws InputError unless `path` is a regular file (or a link to one), naming it as `what` ("surface
+// file") and saying what it is instead: missing, a folder, a named pipe, a device. Every reader checks this
+// before it opens the file: a named pipe or /dev/zero is read without end (the memory grows until the
+// machine gives out), and a pipe read twice, as some readers do, looks like a damaged file.
+void require_regular_file(const std::string& path, const std::string& what);
+
 }  // namespace hexbite

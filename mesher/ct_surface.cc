@@ -477,15 +477,14 @@ VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info, const
 }  // namespace
 
 VoxelVolume read_volume(const std::string& path, VolumeInfo* info, const std::string& dicom_series) {
-  if (!fs::exists(path)) throw InputError("volume file '" + path + "' does not exist");
-  if (fs::is_directory(path)) return volume_from_dicom(path, info, dicom_series);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return volume_from_dicom(path, info, dicom_series);
+  require_regular_file(path, "volume file");
   if (!dicom_series.empty())
     throw InputError("'" + path + "' is a volume file, not a folder of DICOM slices: a DICOM series ('" +
                      dicom_series + "') is chosen only in a folder; leave it out");
   // One file of a DICOM series (the preamble's "DICM" at byte 128), given instead of its folder.
-  char magic[4] = {};
-  std::ifstream(path, std::ios::binary).seekg(128).read(magic, 4);
-  if (std::string(magic, 4) == "DICM") {
+  if (has_dicom_preamble(path)) {
     const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
     throw InputError("'" + path + "' is one DICOM file (a slice of a series); give the folder that holds " +
                      "the series: '" + folder.string() + "'");

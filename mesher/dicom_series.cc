@@ -273,6 +273,13 @@ void quiet_gdcm() {
 
 }  // namespace
 
+bool has_dicom_preamble(const std::string& file) {
+  char magic[4] = {};
+  std::ifstream in(file, std::ios::binary);
+  in.seekg(128).read(magic, 4);
+  return in.gcount() == 4 && std::string(magic, 4) == "DICM";
+}
+
 DicomSeries read_dicom_series(const std::string& folder, const std::string& wanted) {
   if (!fs::is_directory(folder)) throw InputError("DICOM series '" + folder + "' is not a folder");
   quiet_gdcm();

@@ -40,6 +40,10 @@ struct DicomSeries {
 // unevenly spaced (a missing slice), or pixels of more than one sample (colour).
 DicomSeries read_dicom_series(const std::string& folder, const std::string& series = {});
 
+// Whether `file` starts as a DICOM file does: a 128-byte preamble and "DICM" (Part 10). A slice of a series
+// has it; a text file or a volume file given in its place does not.
+bool has_dicom_preamble(const std::string& file);
+
 struct DicomWriteOptions {
   double slope = 1.0;  // stored value = round((value - intercept) / slope), as signed 16-bit integers
   double intercept = 0.0;

@@ -36,6 +36,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/paths.h"
 #include "mesher/hex_quality.h"
 #include "mesher/vtk_messages.h"
 
@@ -44,13 +45,6 @@ namespace hexbite {
 namespace fs = std::filesystem;
 
 namespace {
-
-// The file name's extension in lower case (".vtu"), empty without one.
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
 
 // Shortest decimal text that reads back to the same double, so text files round-trip exactly.
 std::string format_double(double v) {
@@ -61,15 +55,12 @@ std::string format_double(double v) {
 
 // The checks every reader makes before parsing: the file exists, is a regular file, is not empty and opens.
 void check_readable(const std::string& path, const char* what) {
-  std::error_code ec;
-  if (!fs::exists(path, ec))
-    throw InputError("cannot read " + std::string(what) + " '" + path + "': the file does not exist");
-  if (fs::is_directory(path, ec))
-    throw InputError("cannot read " + std::string(what) + " '" + path + "': it is a directory, not a file");
+  require_regular_file(path, std::string(what) + " file");
   std::ifstream probe(path, std::ios::binary);
   if (!probe)
     throw InputError("cannot read " + std::string(what) + " '" + path +
                      "': the file cannot be opened (check permissions)");
+  std::error_code ec;
   if (fs::file_size(path, ec) == 0)
     throw InputError("cannot read " + std::string(what) + " '" + path + "': the file is empty");
 }

@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/number_format.h"
+#include "common/paths.h"
 #include "common/suggestion.h"
 #include "mesher/surface_projector.h"
 #include "mesher/units.h"
@@ -146,9 +147,7 @@ std::optional<Vec3> Landmarks::find(const std::string& name) const {
 }
 
 Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
-  if (!std::filesystem::exists(path)) throw InputError("landmark file '" + path + "' does not exist");
-  if (std::filesystem::is_directory(path))
-    throw InputError("landmark file '" + path + "' is a folder: give the .yaml file in it");
+  require_regular_file(path, "landmark file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

@@ -32,12 +32,8 @@ namespace {
 namespace fs = std::filesystem;
 
 void require_readable_nonempty(const std::string& path) {
+  require_regular_file(path, "quad surface file");
   std::error_code ec;
-  if (!fs::exists(path, ec))
-    throw InputError("quad surface file " + quoted(path) +
-                     " does not exist: check the path and the spelling");
-  if (!fs::is_regular_file(path, ec))
-    throw InputError("quad surface file " + quoted(path) + " is not a regular file (a folder?): give a file");
   if (fs::file_size(path, ec) == 0)
     throw InputError("quad surface file " + quoted(path) + " is empty (0 bytes): export it again");
 }

@@ -57,11 +57,8 @@ void require_known_extension(const std::string& path, const std::string& ext, co
 
 // Checks existence and size first so that these two common mistakes get their own messages.
 void require_readable_nonempty(const std::string& path) {
+  require_regular_file(path, "surface file");
   std::error_code ec;
-  if (!fs::exists(path, ec))
-    throw InputError("surface file " + quoted(path) + " does not exist: check the path and the spelling");
-  if (!fs::is_regular_file(path, ec))
-    throw InputError("surface file " + quoted(path) + " is not a regular file (a folder?): give a file");
   if (fs::file_size(path, ec) == 0)
     throw InputError("surface file " + quoted(path) +
                      " is empty (0 bytes): the export or download did not finish; export it again");

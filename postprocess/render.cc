@@ -221,8 +221,7 @@ void render_surface_png(const TriSurface& surface, const std::string& png_path,
 
 RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& field,
                              const std::string& png_path, const RenderOptions& options) {
-  if (!std::filesystem::is_regular_file(vtu_path))
-    throw InputError("cannot read '" + vtu_path + "': no such file");
+  require_regular_file(vtu_path, "mesh file");
   // A .pvtu (the pieces of a run under mpirun) is read whole: its pieces appended into one grid. The nodes
   // that pieces share appear once per piece, so the faces between pieces count as outer faces too; they
   // lie inside the bone and are hidden in the picture.

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/paths.h"
 #include "postprocess/study_table.h"
 
 namespace hexbite {
@@ -205,6 +206,7 @@ json parse(const std::string& path) {
                      fs::path(path).filename().string() +
                      ", so no finished run: run `hexbite run SCENARIO -o " +
                      fs::path(path).parent_path().string() + "` first");
+  require_regular_file(path, "the run's results file");
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "common/paths.h"
 
 namespace hexbite::yaml_input {
 
@@ -194,10 +195,9 @@ std::optional<SourceLocation> indenting_tab(const std::string& text, int last_li
 }  // namespace
 
 std::string read_yaml_text(const std::string& path, const std::string& kind) {
+  require_regular_file(path, kind + " file");
   std::ifstream in(path, std::ios::binary);
-  if (!in || fs::is_directory(path))
-    throw InputError("cannot read " + kind + " file '" + path + "'; check the path (" + kind +
-                     " files are YAML files)");
+  if (!in) throw InputError("cannot open " + kind + " file '" + path + "': check its permissions");
   std::stringstream text;
   text << in.rdbuf();
   return text.str();

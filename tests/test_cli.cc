@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+
 #include "tests/test_util.h"
 
 namespace hexbite {
@@ -744,6 +746,123 @@ TEST(CliBadInput, MistypedCommandIsNamed) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("a command is required before '--units'"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("unknown command"), std::string::npos) << r.err;
+}
+
+// --help after a mistyped command printed the top-level help, exit 0, as if the command existed; the help
+// of a command that exists, and of a level without its command, is still printed.
+TEST(CliBadInput, MistypedCommandIsNamedWithHelpToo) {
+  auto r = run_hexbite({"rnu", "--help"});
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("unknown command 'rnu'; the commands are: surface,"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  r = run_hexbite({"surface", "nosuch", "--help"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown command 'surface nosuch'"), std::string::npos) << r.err;
+  for (const std::vector<std::string>& args :
+       std::vector<std::vector<std::string>>{{"--help"}, {"surface", "--help"}, {"run", "--help"}}) {
+    r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 0) << args.front() << "\n" << r.err;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
+  }
+}
+
+// A file whose name starts with '-' was read as an option: "MESH is required". The message names the file
+// and how to give it; the same word that is no file is still an unknown option.
+TEST(CliBadInput, AFileNamedLikeAnOptionIsNamed) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/-m.vtu", "x");
+  const std::vector<std::string> in_dir = {"bash", "-c", "cd \"$0\" && exec \"$@\"", dir};
+  auto r = run_hexbite({"quality", "-m.vtu"}, in_dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("'-m.vtu' was read as an option, but it is a file: give it as './-m.vtu', or put "
+                       "'--' before it"),
+            std::string::npos)
+      << r.err;
+  r = run_hexbite({"quality", "-n.vtu"}, in_dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.find("was read as an option"), std::string::npos) << r.err;
+}
+
+// Inputs that are no regular file: a named pipe or /dev/zero was read without end (the memory grew by
+// hundreds of MB a second, or the command hung), and a folder or a pipe got the wrong message ("no such
+// file", "cannot read scenario file", a damaged file). Each reader now says what the input is, at once;
+// `timeout` ends the old behaviour as a failure.
+TEST(CliBadInput, InputsThatAreNoRegularFileAreRefusedAtOnce) {
+  const std::string dir = temp_dir();
+  const std::string cube = dir + "/cube.obj";
+  write_file(cube, cube_obj());
+  ASSERT_EQ(run_hexbite({"-q", "mesh", cube, "--target-hexes", "8", "-o", dir + "/m.vtu"}).exit_code, 0);
+  for (const char* name : {"p.vtu", "p.yaml", "p.mha", "p.stl"})
+    ASSERT_EQ(::mkfifo((dir + "/" + name).c_str(), 0600), 0) << name;
+  for (const char* name : {"z.msh", "z.yaml", "z.mha"}) fs::create_symlink("/dev/zero", dir + "/" + name);
+  fs::create_directories(dir + "/rz");
+  fs::create_symlink("/dev/zero", dir + "/rz/results.json");
+  for (const char* name : {"d.vtu", "d.yaml"}) fs::create_directories(dir + "/" + name);
+  const std::string fifo = "is a named pipe (a FIFO, or a shell's <(...)), not a regular file";
+  const std::string device = "is a device, not a regular file: give a file";
+  const std::string folder = "is a folder, not a file: give a file";
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::string out = dir + "/out";
+  const std::vector<Case> cases = {
+      {{"quality", dir + "/p.vtu"}, "hex mesh file '" + dir + "/p.vtu' " + fifo},
+      {{"quality", dir + "/z.msh"}, "Gmsh mesh file '" + dir + "/z.msh' " + device},
+      {{"refine", dir + "/z.msh", "-o", out + ".vtu"}, device},
+      {{"reorder", dir + "/p.vtu", "-o", out + ".vtu"}, fifo},
+      {{"run", dir + "/p.yaml", "-o", out}, "scenario file '" + dir + "/p.yaml' " + fifo},
+      {{"run", dir + "/z.yaml", "-o", out}, device},
+      {{"run", dir + "/d.yaml", "-o", out}, "scenario file '" + dir + "/d.yaml' " + folder},
+      {{"study", dir + "/p.yaml", "-o", out}, "study file '" + dir + "/p.yaml' " + fifo},
+      {{"study", dir + "/z.yaml", "-o", out}, device},
+      {{"report", dir + "/rz", "-o", out + ".html", "--no-pictures"},
+       "results file '" + dir + "/rz/results.json' " + device},
+      {{"reorder", dir + "/m.vtu", "--landmarks", dir + "/p.yaml", "-o", out + ".vtu"},
+       "landmark file '" + dir + "/p.yaml' " + fifo},
+      {{"mesh", cube, "--landmarks", dir + "/p.yaml", "-o", out + ".vtu"}, fifo},
+      {{"quad", "from-mandible", cube, "--landmarks", dir + "/p.yaml", "-o", out + ".obj"}, fifo},
+      {{"surface", "from-ct", dir + "/z.mha", "--threshold", "600", "-o", out + ".stl"},
+       "volume file '" + dir + "/z.mha' " + device},
+      {{"surface", "from-ct", dir + "/p.mha", "--threshold", "600", "-o", out + ".stl"}, fifo},
+      {{"surface", "check", dir + "/p.stl"}, "surface file '" + dir + "/p.stl' " + fifo},
+      {{"render", dir + "/d.vtu", "-o", out + ".png"}, "mesh file '" + dir + "/d.vtu' " + folder},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args, {"timeout", "20"});
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << c.args[1] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.args[0] << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// An output path with a file where a folder is needed said "folder 'm.vtu' does not exist; create it
+// first", and a path longer than the system takes (PATH_MAX) said the folder does not exist, or failed after
+// the whole run ("File name too long"): both are named when the command line is read.
+TEST(CliBadInput, OutputPathsThroughAFileOrTooLongAreNamed) {
+  const std::string dir = temp_dir();
+  const std::string cube = dir + "/cube.obj";
+  write_file(cube, cube_obj());
+  std::string deep = dir;
+  for (int i = 0; i < 20; ++i) deep += "/" + std::string(240, 'd');
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"reorder", dir + "/m.vtu", "-o", cube + "/x.vtu"}, "'" + cube + "' is a file, not a folder"},
+      {{"mesh", cube, "-o", cube + "/sub/m.vtu"}, "'" + cube + "' is a file, not a folder"},
+      {{"generate", "mandible", "-o", cube + "/g.stl"}, "'" + cube + "' is a file, not a folder"},
+      {{"reorder", dir + "/m.vtu", "-o", deep + "/x.vtu"}, "a path may have (PATH_MAX): give a shorter path"},
+      {{"run", "scenario.yaml", "-o", deep}, "a path may have (PATH_MAX): give a shorter path"},
+      {{"generate", "mandible", "-o", dir + "/g.stl", "--dicom", deep}, "(PATH_MAX)"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_hexbite(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("does not exist"), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -417,6 +418,64 @@ TEST(DicomSeries, GenerateWritesASeriesThatSurfaceFromCtReads) {
   const DicomSeries s = read_dicom_series(dir + "/jaw_ct");
   EXPECT_NEAR(s.spacing[2], 1.5, 1e-9);
   EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/jaw_ct"), fs::directory_iterator{}), s.dims[2]);
+}
+
+// Two outputs of one path failed after the work, when the second was moved in ("a folder of that name is in
+// the way", exit 1); they are a usage error before it, naming both options. Outputs inside the --dicom
+// folder are fine.
+TEST(DicomSeries, GenerateRefusesTwoOutputsOfOnePath) {
+  const std::string dir = test::temp_dir();
+  const std::string jaw = dir + "/jaw.stl";
+  struct Case {
+    std::vector<std::string> options;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {{"--dicom", jaw}, "-o '" + jaw + "' and --dicom '" + jaw + "' are the same path"},
+      {{"--dicom", dir + "/./jaw.stl/"}, "are the same path; give each output its own name"},
+      {{"--ct", dir + "/ct.mha", "--dicom", dir + "/ct.mha"}, "--ct '" + dir + "/ct.mha' and --dicom"},
+      {{"--landmarks", dir + "/l.yaml", "--dicom", dir + "/l.yaml"}, "--landmarks '" + dir + "/l.yaml' and"},
+      {{"--dicom", dir + "/jaw.landmarks.yaml"}, "the landmark file (its default name, from -o)"},
+      {{"--dicom", jaw + "/ct"}, "the second lies inside the first, which is a file"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"generate", "mandible", "-o", jaw};
+    args.insert(args.end(), c.options.begin(), c.options.end());
+    const auto r = test::run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 2) << c.options.back() << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(dir));
+  }
+}
+
+// A folder in the way of a slice's name failed the DICOM folder's commit after the surface, landmarks and
+// CT had been moved in (the earlier jaw.stl replaced); every folder is now checked before the first move.
+// And a file of a slice's name that is no DICOM file (ct_9999.dcm of text) is the user's: an earlier series'
+// retirement removed it.
+TEST(DicomSeries, GenerateLeavesEarlierFilesWhenTheSeriesCannotBeMovedInAndKeepsTheUsersFiles) {
+  const std::string dir = test::temp_dir();
+  fs::create_directories(dir + "/ct/ct_0005.dcm");
+  test::write_file(dir + "/jaw.stl", "OLD\n");
+  const std::map<std::string, std::string> before = test::files_under(dir);
+  const std::vector<std::string> generate = {
+      "-q",      "generate", "mandible", "-o",       dir + "/jaw.stl", "--ct", dir + "/jaw.mha",
+      "--voxel", "1.5",      "--dicom",  dir + "/ct"};
+  auto r = test::run_hexbite(generate);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write '" + dir + "/ct/ct_0005.dcm': a folder of that name is in the way"),
+            std::string::npos)
+      << r.err;
+  test::expect_same_files(before, test::files_under(dir));
+
+  fs::remove(dir + "/ct/ct_0005.dcm");
+  test::write_file(dir + "/ct/ct_9999.dcm", "my notes\n");
+  r = test::run_hexbite(generate);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  fs::copy_file(dir + "/ct/ct_0001.dcm", dir + "/ct/ct_9998.dcm");  // a slice of a longer, earlier series
+  r = test::run_hexbite(generate);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(test::read_file(dir + "/ct/ct_9999.dcm"), "my notes\n");
+  EXPECT_FALSE(fs::exists(dir + "/ct/ct_9998.dcm"));
 }
 
 }  // namespace

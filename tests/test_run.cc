@@ -905,6 +905,12 @@ TEST(RunScenario, FilesOfAnEarlierRunThatThisRunDoesNotWriteAreRemoved) {
   for (const std::string& name : stale) EXPECT_FALSE(fs::exists(out + "/" + name)) << name;
   for (const char* name : {"notes.txt", "results.json", "mesh.vtu", "solution.vtu"})
     EXPECT_TRUE(fs::exists(out + "/" + name)) << name;
+  // Levels go up to 3: a solution_level4.vtu or solution_level10.vtu was never a run's, and was removed.
+  for (const char* name : {"solution_level4.vtu", "solution_level10.vtu", "solution_level4.pvtu"})
+    test::write_file(out + "/" + name, "mine\n");
+  ASSERT_TRUE(run_scenario(dir + "/small.yaml", out).is_object());
+  for (const char* name : {"solution_level4.vtu", "solution_level10.vtu", "solution_level4.pvtu"})
+    EXPECT_EQ(test::read_file(out + "/" + name), "mine\n") << name;
 }
 
 // A run whose set could not be completed used to leave its files written so far beside those of the earlier
