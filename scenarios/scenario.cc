@@ -36,8 +36,9 @@ std::string fmt(double x) {
   return format_significant(x);
 }
 
-std::string fmt(const Vec3& p) {
-  return "[" + fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + "]";
+// `number`: format_rounded for a point the program computed (a landmark's), whose last digits are round-off.
+std::string fmt(const Vec3& p, std::string (*number)(double) = format_significant) {
+  return "[" + number(p[0]) + ", " + number(p[1]) + ", " + number(p[2]) + "]";
 }
 
 std::vector<std::string> split_tokens(const std::string& name) {
@@ -889,7 +890,8 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
     if (length < 1e-9)
       fail(m.origin ? m.origin->where : m.where,
            "muscle " + quote(m.name) + " has a zero line of action: its origin equals its insertion " +
-               fmt(m.insertion.xyz) + "; move the origin or give 'direction: [x, y, z]' instead");
+               fmt(m.insertion.xyz, format_rounded) +
+               "; move the origin or give 'direction: [x, y, z]' instead");
     for (int k = 0; k < 3; ++k) m.line_of_action[k] = d[k] / length;
   }
   for (Support& support : s.supports) resolve(support.at);
@@ -961,7 +963,7 @@ std::vector<int> require_patch_quads(const QuadSurface& boundary, const Vec3& ce
     nearest = std::min(nearest, distance(quad_centroid(boundary, quad), center));
   const std::string found =
       what + " selects no surface facets: no boundary facet centre lies within radius_mm = " + fmt(radius) +
-      " of " + fmt(center) + ", the nearest is " + fmt(nearest) + " mm away";
+      " of " + fmt(center, format_rounded) + ", the nearest is " + format_rounded(nearest) + " mm away";
   // Farther than any patch may reach: a larger radius is no remedy (it is refused), the point is off the
   // meshed bone (a wrong coordinate or unit, or a part of the bone that a coarse mesh lost).
   if (nearest > kMaxPatchRadiusMm)

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "common/number_format.h"
 #include "tests/test_util.h"
 
 namespace hexbite {
@@ -557,6 +558,31 @@ TEST(ScenarioErrors, ImplausibleForceTargetOrCoordinates) {
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    direction: [0, 1e200, 0]")),
       7, "muscles[0].direction[1] is 1e+200");
+}
+
+// Values just past a limit were quoted rounded to 6 digits, and so read as the limit they broke: "poisson
+// 0.45 with solver.degree 1 ... use at most 0.45" for 0.4500001, "1e+07 MPa" for 10000001.
+TEST(ScenarioErrors, AValueJustPastItsLimitIsQuotedWithItsOwnDigits) {
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: 0.4500001}\n"), 12,
+                  "poisson 0.4500001 with solver.degree 1");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: 0.49999999}\n"), 12,
+                  "poisson 0.49999999 with solver.degree 1");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 10000001}\n"), 12,
+                  "materials.default.E_MPa is 10000001 MPa, stiffer");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: 1.0000001")), 6,
+                  "muscles[0].activation is 1.0000001 but an activation must lie in [0, 1]");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    max_force_N: 10000.0001")), 7,
+      "muscles[0].max_force_N is 10000.0001 N, more than 10000 N");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "radius_mm: 4", "radius_mm: 50.00001")), 8,
+                  "supports[0].radius_mm is 50.00001 mm but must be greater than 0 and at most 50 mm");
+  // Values of few digits, and the limits, read as before.
+  EXPECT_EQ(format_significant(0.45), "0.45");
+  EXPECT_EQ(format_significant(1e7), "1e+07");
+  EXPECT_EQ(format_significant(96), "96");
+  EXPECT_EQ(format_significant(0.1 + 0.2), "0.30000000000000004");  // not the 0.3 it is not
+  // A computed figure keeps 6 digits: its further ones are round-off.
+  EXPECT_EQ(format_rounded(0.1 + 0.2), "0.3");
 }
 
 TEST(ScenarioErrors, ASecondYamlDocumentIsRefused) {
