@@ -370,12 +370,20 @@ MeshSettings parse_mesh(const Value& v) {
 // Stiffer than any material (diamond: about 1.05e6 MPa): a modulus above it is one in Pa (1.1e10 for
 // bone), which leaves the stresses right but makes the displacements a million times too small.
 constexpr double kMaxYoungsModulusMPa = 1e7;
+// Softer than any solid (soft gels: about 1e-5 MPa; fat and brain about 1e-3): a modulus below it is a slip
+// of the exponent. Far below it the solve itself broke: 1e-300 gave a non-finite solution blamed on the
+// supports, 4.9e-324 a deal.II exception.
+constexpr double kMinYoungsModulusMPa = 1e-6;
 
 double parse_E(const Value& v) {
   const double E = to_number(v);
   if (E <= 0)
     fail(v.at, v.path + " is " + fmt(E) +
                    " MPa but Young's modulus must be positive; cortical bone is about 11000 MPa");
+  if (E < kMinYoungsModulusMPa)
+    fail(v.at, v.path + " is " + fmt(E) + " MPa, below " + fmt(kMinYoungsModulusMPa) +
+                   " MPa: softer than any solid (a soft gel is about 1e-5 MPa); give the modulus in MPa: "
+                   "cortical bone is about 11000 MPa, a periodontal ligament about 1");
   if (E > kMaxYoungsModulusMPa)
     fail(v.at, v.path + " is " + fmt(E) +
                    " MPa, stiffer than any material (diamond: about 1e6 MPa); give "

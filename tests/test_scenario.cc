@@ -487,6 +487,15 @@ TEST(ScenarioErrors, YoungsModulusMustBePositive) {
   // A modulus in Pa left the stresses right and made the displacements a million times too small.
   EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 1.1e10}\n"), 12,
                   "materials.default.E_MPa is 1.1e+10 MPa, stiffer than any material");
+  // 1e-300 gave a non-finite solution blamed on the supports, 4.9e-324 a deal.II exception with a stack
+  // trace: softer than any solid, refused at the line like a modulus in Pa.
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 1e-300}\n"), 12,
+                  "materials.default.E_MPa is 1e-300 MPa, below 1e-06 MPa: softer than any solid");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  regions:\n    - {name: r, sphere: {center: [0, 0, 0], "
+                                    "radius_mm: 2}, E_MPa: 4.9e-324}\n"),
+                  13, "materials.regions[0].E_MPa is 4.94066e-324 MPa, below 1e-06 MPa");
+  // The bound itself is allowed.
+  EXPECT_NO_THROW(load_scenario(write_scenario(kValid + "materials:\n  default: {E_MPa: 1e-6}\n")));
 }
 
 TEST(ScenarioErrors, PoissonOutsideItsRange) {
