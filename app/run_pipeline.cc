@@ -242,9 +242,9 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
     info(line);
   }
   if (!report.boundary_crossings.empty())
-    throw RunError(s.path + ": the sheet mesher's mesh at mesh.target_hexes = " +
-                   std::to_string(s.mesh.target_hexes) + ": " + report.boundary_crossing_text +
-                   "; try another target or method: grid");
+    throw RunError(s.path +
+                   ": the sheet mesher's mesh at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
+                   ": " + report.boundary_crossing_text + "; try another target or method: grid");
   if (report.inverted > 0)
     throw RunError(s.path + ": at mesh.target_hexes = " + std::to_string(s.mesh.target_hexes) +
                    " the sheet mesher left " + inverted_hexes_text(mesh) +
@@ -980,7 +980,10 @@ void require_trustworthy(const RunResult& result, const std::string& results) {
                     "level %d: the largest displacement, %.3g mm, is more than %.0f %% of the bone's size "
                     "(%.1f mm), but linear elasticity holds only for small displacements",
                     l.level, l.solution.max_displacement, 100 * kMaxDisplacementFraction, size);
-      throw RunError(std::string(text) + "; " + results +
+      // At the modulus, the likeliest slip (1e-6 for 11000), as the equilibrium failure names its tolerance;
+      // without one, the file, so that a study's or a script's log says which scenario failed.
+      const SourceLocation& E_at = result.scenario.materials.default_material.E_MPa_at;
+      throw RunError((E_at.line ? E_at.str() : result.scenario.path) + ": " + text + "; " + results +
                      " are meaningless: check materials E_MPa (in MPa, cortical bone about 11000), the "
                      "muscles' max_force_N (in N) and that the supports hold the bone");
     }

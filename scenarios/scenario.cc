@@ -405,7 +405,10 @@ Materials parse_materials(const Value& v) {
   Materials m;
   if (auto x = map.find("default")) {
     const Map d(*x, {"E_MPa", "poisson"});
-    if (auto y = d.find("E_MPa")) m.default_material.E_MPa = parse_E(*y);
+    if (auto y = d.find("E_MPa")) {
+      m.default_material.E_MPa = parse_E(*y);
+      m.default_material.E_MPa_at = y->at;
+    }
     if (auto y = d.find("poisson")) {
       m.default_material.poisson = parse_poisson(*y);
       m.default_material.poisson_at = y->at;
@@ -436,7 +439,10 @@ Materials parse_materials(const Value& v) {
              item.path + " (" + quote(region.name) +
                  ") changes nothing; give E_MPa and/or poisson (the one left out keeps the default)");
       region.material = m.default_material;
-      if (auto y = r.find("E_MPa")) region.material.E_MPa = parse_E(*y);
+      if (auto y = r.find("E_MPa")) {
+        region.material.E_MPa = parse_E(*y);
+        region.material.E_MPa_at = y->at;
+      }
       if (auto y = r.find("poisson")) {
         region.material.poisson = parse_poisson(*y);
         region.material.poisson_at = y->at;

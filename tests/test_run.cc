@@ -980,11 +980,22 @@ TEST(RunScenario, AWriteThatFailsLeavesTheEarlierRunUntouchedAndCreatesNoFolder)
 TEST(RunScenario, DisplacementsLargeAgainstTheBoneFailTheRun) {
   const std::string dir = test::temp_dir();
   test::write_file(dir + "/soft.yaml", kSmall + "materials:\n  default: {E_MPa: 1.0e-6}\n");
-  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/soft.yaml", "-o", dir + "/out"});
+  test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/soft.yaml", "-o", dir + "/out"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("level 0: the largest displacement"), std::string::npos) << r.err;
+  // Named at the modulus, as the equilibrium failure is at its tolerance; it named no file at all.
+  EXPECT_NE(r.err.find(dir + "/soft.yaml:12:20: level 0: the largest displacement"), std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("check materials E_MPa"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/out/results.json"));
+  // Without a default modulus written, the file alone.
+  test::write_file(dir + "/soft_region.yaml",
+                   kSmall +
+                       "materials:\n  regions:\n    - {name: all, box: {min: [-500, -500, -500], max: "
+                       "[500, 500, 500]}, E_MPa: 1.0e-6}\n");
+  r = test::run_hexbite({"-q", "run", dir + "/soft_region.yaml", "-o", dir + "/out_region"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/soft_region.yaml: level 0: the largest displacement"), std::string::npos)
+      << r.err;
 }
 
 // A loose solver tolerance leaves the forces unbalanced: the run fails naming the residual, which it used to
