@@ -447,8 +447,57 @@ MeshPatch refined_patch(const HexMesh& fine, const RefinementMap& map, const Mes
   return patch;
 }
 
+// The coarse mesh's materials: a hex takes a region's material by its centre. A region that wins no hex
+// changes nothing, which must not pass for a simulated implant or resorption site: InputError at its line.
+void assign_materials(const Scenario& s, LevelResult& r) {
+  const std::size_t regions = s.materials.regions.size();
+  std::vector<int> hexes_of_region(regions, 0);
+  std::vector<double> nearest_centre(regions, std::numeric_limits<double>::infinity());
+  r.hex_material.reserve(r.mesh.hexes.size());
+  for (std::size_t h = 0; h < r.mesh.hexes.size(); ++h) {
+    const Vec3 centre = hex_centroid(r.mesh, static_cast<int>(h));
+    const int region = region_at(s.materials, centre);
+    const MaterialSpec& m = region < 0 ? s.materials.default_material
+                                       : s.materials.regions[static_cast<std::size_t>(region)].material;
+    r.hex_material.push_back({m.E_MPa, m.poisson});
+    if (region >= 0) ++hexes_of_region[static_cast<std::size_t>(region)];
+    for (std::size_t i = 0; i < regions; ++i)
+      nearest_centre[i] = std::min(nearest_centre[i], distance_outside(s.materials.regions[i], centre));
+  }
+  r.region_hexes = hexes_of_region;
+  for (std::size_t i = 0; i < regions; ++i) {
+    if (hexes_of_region[i] > 0) continue;
+    const MaterialRegion& region = s.materials.regions[i];
+    char buf[300];
+    if (nearest_centre[i] > 0)
+      std::snprintf(
+          buf, sizeof buf,
+          "the nearest hex centre is %.1f mm outside it: move it into the bone or enlarge it, or make "
+          "the mesh finer (mesh.target_hexes)",
+          nearest_centre[i]);
+    else
+      std::snprintf(buf, sizeof buf,
+                    "every hex centre inside it takes the material of a later region that overlaps it: "
+                    "reorder or reshape the regions");
+    throw InputError(region.where.str() + ": material region '" + region.name + "' holds no hex of the " +
+                     std::to_string(r.mesh.hexes.size()) + "-hex mesh, so it would change nothing; " + buf);
+  }
+}
+
+// A refined level's materials: every hex takes its parent's (fine hex f lies in coarse hex f / 8,
+// mesher/hex_refine.h), so that every level solves the same material distribution, as it does the same
+// patches. By their own centres the children of a small region's hexes fell outside it: a 0.5 mm sphere
+// holding one coarse hex held none at level 1, and a 1 mm box's 23 coarse hexes became 110 fine ones, not
+// 184.
+void inherit_materials(const LevelResult& coarser, LevelResult& r) {
+  r.hex_material.reserve(r.mesh.hexes.size());
+  for (std::size_t f = 0; f < r.mesh.hexes.size(); ++f) r.hex_material.push_back(coarser.hex_material[f / 8]);
+  r.region_hexes = coarser.region_hexes;
+  for (int& hexes : r.region_hexes) hexes *= 8;
+}
+
 // Everything of a level that depends only on its mesh: quality, patches and materials. A refined level
-// (`coarser` given, the level it was refined from once) takes its patches from that level's.
+// (`coarser` given, the level it was refined from once) takes its patches and materials from that level's.
 LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const LevelResult* coarser = nullptr) {
   LevelResult r;
   r.level = level;
@@ -481,41 +530,10 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const Leve
     if (s.supports[i].contact)
       r.contact_directions[i] = contact_direction(s.supports[i], r.support_patches[i], r.mesh);
   r.probe_points = probe_points_in_mesh(r.mesh, boundary, s.probes, /*coarse=*/coarser == nullptr);
-  r.hex_material.reserve(r.mesh.hexes.size());
-  // A hex takes a region's material by its centre; a region that wins no hex changes nothing, which
-  // must not pass for a simulated implant or resorption site. Checked on the coarse mesh (finer levels
-  // only add hexes inside the same bone).
-  const std::size_t regions = s.materials.regions.size();
-  std::vector<int> hexes_of_region(regions, 0);
-  std::vector<double> nearest_centre(regions, std::numeric_limits<double>::infinity());
-  for (std::size_t h = 0; h < r.mesh.hexes.size(); ++h) {
-    const Vec3 centre = hex_centroid(r.mesh, static_cast<int>(h));
-    const int region = region_at(s.materials, centre);
-    const MaterialSpec& m = region < 0 ? s.materials.default_material
-                                       : s.materials.regions[static_cast<std::size_t>(region)].material;
-    r.hex_material.push_back({m.E_MPa, m.poisson});
-    if (region >= 0) ++hexes_of_region[static_cast<std::size_t>(region)];
-    for (std::size_t i = 0; i < regions && level == 0; ++i)
-      nearest_centre[i] = std::min(nearest_centre[i], distance_outside(s.materials.regions[i], centre));
-  }
-  r.region_hexes = hexes_of_region;
-  for (std::size_t i = 0; i < regions && level == 0; ++i) {
-    if (hexes_of_region[i] > 0) continue;
-    const MaterialRegion& region = s.materials.regions[i];
-    char buf[300];
-    if (nearest_centre[i] > 0)
-      std::snprintf(
-          buf, sizeof buf,
-          "the nearest hex centre is %.1f mm outside it: move it into the bone or enlarge it, or make "
-          "the mesh finer (mesh.target_hexes)",
-          nearest_centre[i]);
-    else
-      std::snprintf(buf, sizeof buf,
-                    "every hex centre inside it takes the material of a later region that overlaps it: "
-                    "reorder or reshape the regions");
-    throw InputError(region.where.str() + ": material region '" + region.name + "' holds no hex of the " +
-                     std::to_string(r.mesh.hexes.size()) + "-hex mesh, so it would change nothing; " + buf);
-  }
+  if (coarser)
+    inherit_materials(*coarser, r);
+  else
+    assign_materials(s, r);
   return r;
 }
 
@@ -986,7 +1004,10 @@ void require_trustworthy(const RunResult& result, const std::string& results) {
                     "level %d: the largest displacement, %.3g mm, is more than %.0f %% of the bone's size "
                     "(%.1f mm), but linear elasticity holds only for small displacements",
                     l.level, l.solution.max_displacement, 100 * kMaxDisplacementFraction, size);
-      throw RunError(std::string(text) + "; " + results +
+      // At the modulus, the likeliest slip (1e-6 for 11000), as the equilibrium failure names its tolerance;
+      // without one, the file, so that a study's or a script's log says which scenario failed.
+      const SourceLocation& E_at = result.scenario.materials.default_material.E_MPa_at;
+      throw RunError((E_at.line ? E_at.str() : result.scenario.path) + ": " + text + "; " + results +
                      " are meaningless: check materials E_MPa (in MPa, cortical bone about 11000), the "
                      "muscles' max_force_N (in N) and that the supports hold the bone");
     }

@@ -1,6 +1,6 @@
 // The end-to-end bite simulation behind `hexbite run`: scenario -> geometry and landmarks -> hex mesh ->
 // boundary patches -> per-hex materials -> elasticity solve -> validation levels (the mesh refined 8-way onto
-// the surface, the patches selected again with the same centres and radii, solved again).
+// the surface, every patch and every hex's material carried over from the coarser level, solved again).
 //
 // Input: a loaded Scenario (scenarios/scenario.h) and the number of validation levels.
 // Output: one LevelResult per level (level 0 is the coarse mesh) with the mesh, the patches, the problem's

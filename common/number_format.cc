@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace hexbite {
@@ -20,6 +21,15 @@ std::string format_table_number(double value, int decimals, int width) {
 }
 
 std::string format_significant(double value) {
+  char text[32];
+  for (int digits = 6; digits <= 17; ++digits) {  // 17 digits read back as any double
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  return text;
+}
+
+std::string format_rounded(double value) {
   std::ostringstream out;
   out << value;
   return out.str();

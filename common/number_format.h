@@ -13,9 +13,16 @@ namespace hexbite {
 // files that programs read (results.json keeps full precision).
 std::string format_table_number(double value, int decimals, int width);
 
-// `value` as a stream prints it by default, with up to 6 significant digits: "96", "0.25", "1e+06". For
-// the numbers that a message about an input quotes back.
+// `value` as written in an input: as a stream prints it by default, with up to 6 significant digits ("96",
+// "0.25", "1e+06"), or with as many more as it takes to read back as the same number ("0.4500001",
+// "10000001"). For the numbers that a message about an input quotes back: rounded to 6 digits, a value
+// just past a limit read as the limit itself ("poisson 0.45 ... use at most 0.45" for 0.4500001).
 std::string format_significant(double value);
+
+// `value` with up to 6 significant digits, as a stream prints it: "96", "0.25", "1e+06", "44.5" for
+// 44.499999999999993. For figures the program computed (a distance, a landmark's coordinates), whose
+// further digits are round-off; never for a value that a message compares with a limit.
+std::string format_rounded(double value);
 
 // `n` and the noun, plural when n is not 1: "1 file", "3 files" (nouns that take an "s").
 std::string format_counted(std::size_t n, const std::string& noun);

@@ -286,8 +286,8 @@ RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& fie
       throw InputError(
           "the colour scale's top, " + format_significant(options.colour_max) +
           ", is not above the smallest value of '" + field + "' in '" + vtu_path +
-          "' (the values range from " + format_significant(range[0]) + " to " + format_significant(range[1]) +
-          "): every face would show in one colour; give a --max above " + format_significant(range[0]));
+          "' (the values range from " + format_rounded(range[0]) + " to " + format_rounded(range[1]) +
+          "): every face would show in one colour; give a --max above " + format_rounded(range[0]));
     range[1] = options.colour_max;
   }
   colours->SetHueRange(0.667, 0.0);  // blue (low) to red (high)

@@ -36,8 +36,9 @@ std::string fmt(double x) {
   return format_significant(x);
 }
 
-std::string fmt(const Vec3& p) {
-  return "[" + fmt(p[0]) + ", " + fmt(p[1]) + ", " + fmt(p[2]) + "]";
+// `number`: format_rounded for a point the program computed (a landmark's), whose last digits are round-off.
+std::string fmt(const Vec3& p, std::string (*number)(double) = format_significant) {
+  return "[" + number(p[0]) + ", " + number(p[1]) + ", " + number(p[2]) + "]";
 }
 
 std::vector<std::string> split_tokens(const std::string& name) {
@@ -369,12 +370,20 @@ MeshSettings parse_mesh(const Value& v) {
 // Stiffer than any material (diamond: about 1.05e6 MPa): a modulus above it is one in Pa (1.1e10 for
 // bone), which leaves the stresses right but makes the displacements a million times too small.
 constexpr double kMaxYoungsModulusMPa = 1e7;
+// Softer than any solid (soft gels: about 1e-5 MPa; fat and brain about 1e-3): a modulus below it is a slip
+// of the exponent. Far below it the solve itself broke: 1e-300 gave a non-finite solution blamed on the
+// supports, 4.9e-324 a deal.II exception.
+constexpr double kMinYoungsModulusMPa = 1e-6;
 
 double parse_E(const Value& v) {
   const double E = to_number(v);
   if (E <= 0)
     fail(v.at, v.path + " is " + fmt(E) +
                    " MPa but Young's modulus must be positive; cortical bone is about 11000 MPa");
+  if (E < kMinYoungsModulusMPa)
+    fail(v.at, v.path + " is " + fmt(E) + " MPa, below " + fmt(kMinYoungsModulusMPa) +
+                   " MPa: softer than any solid (a soft gel is about 1e-5 MPa); give the modulus in MPa: "
+                   "cortical bone is about 11000 MPa, a periodontal ligament about 1");
   if (E > kMaxYoungsModulusMPa)
     fail(v.at, v.path + " is " + fmt(E) +
                    " MPa, stiffer than any material (diamond: about 1e6 MPa); give "
@@ -396,7 +405,10 @@ Materials parse_materials(const Value& v) {
   Materials m;
   if (auto x = map.find("default")) {
     const Map d(*x, {"E_MPa", "poisson"});
-    if (auto y = d.find("E_MPa")) m.default_material.E_MPa = parse_E(*y);
+    if (auto y = d.find("E_MPa")) {
+      m.default_material.E_MPa = parse_E(*y);
+      m.default_material.E_MPa_at = y->at;
+    }
     if (auto y = d.find("poisson")) {
       m.default_material.poisson = parse_poisson(*y);
       m.default_material.poisson_at = y->at;
@@ -427,7 +439,10 @@ Materials parse_materials(const Value& v) {
              item.path + " (" + quote(region.name) +
                  ") changes nothing; give E_MPa and/or poisson (the one left out keeps the default)");
       region.material = m.default_material;
-      if (auto y = r.find("E_MPa")) region.material.E_MPa = parse_E(*y);
+      if (auto y = r.find("E_MPa")) {
+        region.material.E_MPa = parse_E(*y);
+        region.material.E_MPa_at = y->at;
+      }
       if (auto y = r.find("poisson")) {
         region.material.poisson = parse_poisson(*y);
         region.material.poisson_at = y->at;
@@ -889,7 +904,8 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
     if (length < 1e-9)
       fail(m.origin ? m.origin->where : m.where,
            "muscle " + quote(m.name) + " has a zero line of action: its origin equals its insertion " +
-               fmt(m.insertion.xyz) + "; move the origin or give 'direction: [x, y, z]' instead");
+               fmt(m.insertion.xyz, format_rounded) +
+               "; move the origin or give 'direction: [x, y, z]' instead");
     for (int k = 0; k < 3; ++k) m.line_of_action[k] = d[k] / length;
   }
   for (Support& support : s.supports) resolve(support.at);
@@ -961,7 +977,7 @@ std::vector<int> require_patch_quads(const QuadSurface& boundary, const Vec3& ce
     nearest = std::min(nearest, distance(quad_centroid(boundary, quad), center));
   const std::string found =
       what + " selects no surface facets: no boundary facet centre lies within radius_mm = " + fmt(radius) +
-      " of " + fmt(center) + ", the nearest is " + fmt(nearest) + " mm away";
+      " of " + fmt(center, format_rounded) + ", the nearest is " + format_rounded(nearest) + " mm away";
   // Farther than any patch may reach: a larger radius is no remedy (it is refused), the point is off the
   // meshed bone (a wrong coordinate or unit, or a part of the bone that a coarse mesh lost).
   if (nearest > kMaxPatchRadiusMm)

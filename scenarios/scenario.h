@@ -96,6 +96,7 @@ struct MeshSettings {
 struct MaterialSpec {
   double E_MPa = 11000;
   double poisson = 0.28;
+  SourceLocation E_MPa_at;    // where `E_MPa` was written (empty: the default)
   SourceLocation poisson_at;  // where `poisson` was written (empty: the default)
 };
 

@@ -567,6 +567,39 @@ TEST(RunScenario, MaterialRegionHoldingNoHexIsRefusedAtItsLine) {
   EXPECT_NE(err.find("mm outside it: move it into the bone or enlarge it"), std::string::npos) << err;
 }
 
+// Material regions were given on every level by the refined hexes' own centres, while the patches were the
+// coarse level's split: a 0.5 mm implant around the centre of one coarse hex held no hex at level 1, which
+// solved the bone without it (a study reported 0.0 % for that what-if). Every refined hex now takes its
+// parent's material: the region's hexes at level 1 are the 8 children of its coarse one.
+TEST(RunScenario, ValidationLevelsKeepTheCoarseMaterialRegions) {
+  const std::string dir = test::temp_dir();
+  std::string base = kSmall;
+  base.replace(base.find("target_hexes: 4000"), 18, "target_hexes: 2000");
+  ASSERT_TRUE(run_scenario(write_scenario(base), dir + "/plain").is_object());  // the coarse mesh to aim at
+  const HexMesh coarse = read_vtu(dir + "/plain/mesh.vtu");
+  const int implant = static_cast<int>(coarse.hexes.size() / 2);
+  const Vec3 c = hex_centroid(coarse, implant);
+  std::string text = base + "materials:\n  regions:\n    - {name: implant, sphere: {center: [" +
+                     format_significant(c[0]) + ", " + format_significant(c[1]) + ", " +
+                     format_significant(c[2]) + "], radius_mm: 0.5}, E_MPa: 1}\n";
+  text.replace(text.find("validation_levels: 0"), 20, "validation_levels: 1");
+  const json r = run_scenario(write_scenario(text), dir + "/implant");
+  ASSERT_TRUE(r.is_object());
+  EXPECT_EQ(r["materials"]["regions"][0]["hexes"], 1);
+  for (int level = 0; level <= 1; ++level) {
+    std::vector<MeshArray> cells;
+    const HexMesh mesh = read_vtu(dir + "/implant/solution" + (level ? "_level1" : "") + ".vtu", &cells);
+    const MeshArray& E = array(cells, "E_MPa");
+    ASSERT_EQ(E.values.size(), mesh.hexes.size());
+    std::vector<int> soft;
+    for (std::size_t h = 0; h < E.values.size(); ++h)
+      if (E.values[h] == 1.0) soft.push_back(static_cast<int>(h));
+    std::vector<int> expected;
+    for (int k = 0; k < (level ? 8 : 1); ++k) expected.push_back((level ? 8 : 1) * implant + k);
+    EXPECT_EQ(soft, expected) << "level " << level;
+  }
+}
+
 // A geometry of two separate bodies (the fragments of a fractured mandible, say) with supports on one only:
 // the other could move freely. Refused before the solve, naming that body; before, the solve ran and
 // failed its equilibrium check with displacements of 1e12 mm and the advice to tighten the tolerance.
@@ -986,11 +1019,22 @@ TEST(RunScenario, AWriteThatFailsLeavesTheEarlierRunUntouchedAndCreatesNoFolder)
 TEST(RunScenario, DisplacementsLargeAgainstTheBoneFailTheRun) {
   const std::string dir = test::temp_dir();
   test::write_file(dir + "/soft.yaml", kSmall + "materials:\n  default: {E_MPa: 1.0e-6}\n");
-  const test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/soft.yaml", "-o", dir + "/out"});
+  test::CommandResult r = test::run_hexbite({"-q", "run", dir + "/soft.yaml", "-o", dir + "/out"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("level 0: the largest displacement"), std::string::npos) << r.err;
+  // Named at the modulus, as the equilibrium failure is at its tolerance; it named no file at all.
+  EXPECT_NE(r.err.find(dir + "/soft.yaml:12:20: level 0: the largest displacement"), std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("check materials E_MPa"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(dir + "/out/results.json"));
+  // Without a default modulus written, the file alone.
+  test::write_file(dir + "/soft_region.yaml",
+                   kSmall +
+                       "materials:\n  regions:\n    - {name: all, box: {min: [-500, -500, -500], max: "
+                       "[500, 500, 500]}, E_MPa: 1.0e-6}\n");
+  r = test::run_hexbite({"-q", "run", dir + "/soft_region.yaml", "-o", dir + "/out_region"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/soft_region.yaml: level 0: the largest displacement"), std::string::npos)
+      << r.err;
 }
 
 // A loose solver tolerance leaves the forces unbalanced: the run fails naming the residual, which it used to

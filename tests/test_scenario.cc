@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "common/number_format.h"
 #include "tests/test_util.h"
 
 namespace hexbite {
@@ -486,6 +487,15 @@ TEST(ScenarioErrors, YoungsModulusMustBePositive) {
   // A modulus in Pa left the stresses right and made the displacements a million times too small.
   EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 1.1e10}\n"), 12,
                   "materials.default.E_MPa is 1.1e+10 MPa, stiffer than any material");
+  // 1e-300 gave a non-finite solution blamed on the supports, 4.9e-324 a deal.II exception with a stack
+  // trace: softer than any solid, refused at the line like a modulus in Pa.
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 1e-300}\n"), 12,
+                  "materials.default.E_MPa is 1e-300 MPa, below 1e-06 MPa: softer than any solid");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  regions:\n    - {name: r, sphere: {center: [0, 0, 0], "
+                                    "radius_mm: 2}, E_MPa: 4.9e-324}\n"),
+                  13, "materials.regions[0].E_MPa is 4.94066e-324 MPa, below 1e-06 MPa");
+  // The bound itself is allowed.
+  EXPECT_NO_THROW(load_scenario(write_scenario(kValid + "materials:\n  default: {E_MPa: 1e-6}\n")));
 }
 
 TEST(ScenarioErrors, PoissonOutsideItsRange) {
@@ -557,6 +567,31 @@ TEST(ScenarioErrors, ImplausibleForceTargetOrCoordinates) {
   EXPECT_ERROR_AT(
       error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    direction: [0, 1e200, 0]")),
       7, "muscles[0].direction[1] is 1e+200");
+}
+
+// Values just past a limit were quoted rounded to 6 digits, and so read as the limit they broke: "poisson
+// 0.45 with solver.degree 1 ... use at most 0.45" for 0.4500001, "1e+07 MPa" for 10000001.
+TEST(ScenarioErrors, AValueJustPastItsLimitIsQuotedWithItsOwnDigits) {
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: 0.4500001}\n"), 12,
+                  "poisson 0.4500001 with solver.degree 1");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {poisson: 0.49999999}\n"), 12,
+                  "poisson 0.49999999 with solver.degree 1");
+  EXPECT_ERROR_AT(error_of(kValid + "materials:\n  default: {E_MPa: 10000001}\n"), 12,
+                  "materials.default.E_MPa is 10000001 MPa, stiffer");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "activation: 0.5", "activation: 1.0000001")), 6,
+                  "muscles[0].activation is 1.0000001 but an activation must lie in [0, 1]");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "    activation: 0.5", "    activation: 0.5\n    max_force_N: 10000.0001")), 7,
+      "muscles[0].max_force_N is 10000.0001 N, more than 10000 N");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "radius_mm: 4", "radius_mm: 50.00001")), 8,
+                  "supports[0].radius_mm is 50.00001 mm but must be greater than 0 and at most 50 mm");
+  // Values of few digits, and the limits, read as before.
+  EXPECT_EQ(format_significant(0.45), "0.45");
+  EXPECT_EQ(format_significant(1e7), "1e+07");
+  EXPECT_EQ(format_significant(96), "96");
+  EXPECT_EQ(format_significant(0.1 + 0.2), "0.30000000000000004");  // not the 0.3 it is not
+  // A computed figure keeps 6 digits: its further ones are round-off.
+  EXPECT_EQ(format_rounded(0.1 + 0.2), "0.3");
 }
 
 TEST(ScenarioErrors, ASecondYamlDocumentIsRefused) {
