@@ -38,8 +38,9 @@ double norm(const Vec3& v) {
 json level_figures(const Scenario& s, const LevelResult& l) {
   const ElasticitySolution& u = l.solution;
   json reactions = json::object();
-  // Each level selects its patches again on its own boundary (running.md, step 6), so a patch's area
-  // differs between levels; it is given per level (the supports' list gives the coarse level's only).
+  // A refined level carries its coarser level's patches, each quad split into 4 (running.md, step 6), and
+  // its area changes with the new boundary nodes' projection; it is given per level (the supports' list
+  // gives the coarse level's only).
   for (std::size_t i = 0; i < u.reactions.size(); ++i) {
     const SupportReaction& r = u.reactions[i];
     reactions[r.name] = {{"force_N", vec(r.force)},
