@@ -15,6 +15,8 @@
 #include "common/suggestion.h"
 #include "mesher/surface_projector.h"
 #include "mesher/units.h"
+#include "mesher/vec3.h"
+#include "mesher/yaml_scalars.h"
 
 namespace hexbite {
 
@@ -40,13 +42,11 @@ void claim_name(const std::string& path, const YAML::Mark& mark, const std::stri
              "; keep one");
 }
 
+// Numbers as a scenario takes them: plain, not quoted (yaml_scalars.h).
 double read_number(const std::string& path, const YAML::Node& node, const std::string& what) {
-  if (!node.IsScalar()) fail(path, node.Mark(), what + " must be a number");
-  double value = 0;
-  if (!YAML::convert<double>::decode(node, value))
-    fail(path, node.Mark(), what + " must be a number, not '" + node.Scalar() + "'");
-  if (!std::isfinite(value)) fail(path, node.Mark(), what + " is not finite ('" + node.Scalar() + "')");
-  return value;
+  const std::optional<double> value = plain_number(node);
+  if (!value) fail(path, node.Mark(), what + " must be a number, " + number_expected(node));
+  return *value;
 }
 
 // A point in mm, each coordinate within kMaxCoordinateMm like a scenario's own (scenarios/scenario.cc), also
@@ -132,6 +132,12 @@ std::string format_number(double v) {
 
 }  // namespace
 
+std::string ambiguous_name_text(const std::string& point, const std::string& other,
+                                const std::string& other_short) {
+  return point + " has the name of " + other + ", so the name would be ambiguous; rename it or use " +
+         other_short;
+}
+
 std::optional<Vec3> Landmarks::find(const std::string& name) const {
   if (auto it = points.find(name); it != points.end()) return it->second;
   const auto dot = name.rfind('.');
@@ -161,7 +167,8 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
   if (!root.IsMap()) fail(path, root.Mark(), "expected a map with 'landmarks:' and 'muscles:'");
 
   Landmarks out;
-  std::map<std::string, int> names;  // name -> the 1-based line where it is first given
+  std::map<std::string, int> names;               // name -> the 1-based line where it is first given
+  std::map<std::string, YAML::Mark> point_marks;  // landmark name -> its key
   try {
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();
@@ -172,6 +179,7 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
         for (const auto& lm : value) {
           const std::string name = lm.first.as<std::string>();
           claim_name(path, lm.first.Mark(), name, names);
+          point_marks.emplace(name, lm.first.Mark());
           out.points[name] = read_point(path, lm.second, "landmark '" + name + "'", scale_to_mm);
         }
       } else if (key == "muscles") {
@@ -187,6 +195,19 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
                                   "reorder` in millimetres"
                                 : suggestion(key, {"landmarks", "muscles"}, "sections")));
       }
+    }
+    // Landmarks::find and a scenario take "<muscle>.insertion" for the muscle's point, so a landmark of
+    // that name would be silently shadowed by it.
+    for (const auto& [name, mark] : point_marks) {
+      const auto dot = name.rfind('.');
+      if (dot == std::string::npos) continue;
+      const std::string muscle = name.substr(0, dot), part = name.substr(dot + 1);
+      if ((part == "insertion" || part == "origin") && names.count(muscle) && !out.points.count(muscle))
+        fail(path, mark,
+             ambiguous_name_text("landmark '" + name + "'",
+                                 "the " + part + " of muscle '" + muscle + "' (line " +
+                                     std::to_string(names.at(muscle)) + ")",
+                                 "the muscle's " + part));
     }
   } catch (const YAML::Exception& e) {
     // Keys that are not scalars (e.g. a list used as a key) end up here; yaml-cpp says only "bad conversion".

@@ -31,6 +31,12 @@ struct Landmarks {
   std::optional<Vec3> find(const std::string& name) const;
 };
 
+// The refusal of a point whose name is another's: "<point> has the name of <other>, so the name would be
+// ambiguous; rename it or use <other_short>" (a scenario's extra point named like a landmark, a landmark
+// named like a muscle's insertion).
+std::string ambiguous_name_text(const std::string& point, const std::string& other,
+                                const std::string& other_short);
+
 // Throws InputError naming the file and line for malformed files.
 Landmarks read_landmarks(const std::string& path, double scale_to_mm = 1.0);
 // Written atomically with a header comment giving the frame; deterministic.

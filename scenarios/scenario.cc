@@ -74,14 +74,9 @@ std::vector<std::string> closest_names(const std::string& given, const std::vect
 }
 
 double to_number(const Value& v) {
-  double x = 0;
-  if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<double>::decode(v.node, x) ||
-      !std::isfinite(x))
-    fail(v.at, v.path + " must be a number, found " + describe(v.node) +
-                   (is_quoted(v.node) && YAML::convert<double>::decode(v.node, x) && std::isfinite(x)
-                        ? "; write it as a plain number, without quotes: " + v.node.Scalar()
-                        : "; write a plain finite number such as 2.5"));
-  return x;
+  const std::optional<double> x = plain_number(v.node);
+  if (!x) fail(v.at, v.path + " must be a number, " + number_expected(v.node));
+  return *x;
 }
 
 // A whole number of any size (up to 2^53); the callers check their ranges on it, so that 1e10 is "out of
@@ -811,9 +806,7 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
   }
   for (const NamedPoint& p : s.landmarks.points) {
     if (known.count(p.name))
-      fail(p.where,
-           "extra point " + quote(p.name) +
-               " has the name of a landmark, so the name would be ambiguous; rename it or use the landmark");
+      fail(p.where, ambiguous_name_text("extra point " + quote(p.name), "a landmark", "the landmark"));
     known[p.name] = p.xyz;
   }
   std::vector<std::string> known_names;

@@ -397,8 +397,11 @@ TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
                         ":3:10: landmark 'b' coordinate is 1e+300, beyond 1e+06 mm in size");
   expect_landmark_error("landmarks:\n  a: [-2000000, 0, 0]\n",
                         ":2:7: landmark 'a' coordinate is -2e+06, beyond");
-  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n", ":2:7: landmark 'a' coordinate is not finite");
-  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n", ":2:13: landmark 'a' coordinate is not finite");
+  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n",
+                        ":2:7: landmark 'a' coordinate must be a number, found '.nan'; write a plain finite "
+                        "number such as 2.5");
+  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n",
+                        ":2:13: landmark 'a' coordinate must be a number, found '-.inf'");
   expect_landmark_error(
       "muscles:\n  - {name: m, max_force_N: 1,\n     insertion: [0, 0, 0],\n     origin: [0, 0, 1e7]}\n",
       ":4:21: muscle 'm' origin coordinate is 1e+07, beyond 1e+06 mm in size");
@@ -422,6 +425,36 @@ TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
                    "landmarks:\n  a: [1e6, -1e6, 0]\nmuscles:\n  - {name: m, max_force_N: 10000, "
                    "insertion: [0, 0, 0], origin: [0, 0, 1]}\n");
   EXPECT_EQ(read_landmarks(path).muscles.at(0).max_force_N, 10000.0);
+}
+
+// Quoted numbers were read as numbers, where a scenario refuses them ("a quoted "0.5" is text"): the same
+// rule and message now.
+TEST(Landmarks, QuotedNumbersAreRefusedAsInAScenario) {
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: \"190.4\", insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
+      ":2:28: muscle 'm' max_force_N must be a number, found the quoted text \"190.4\"; write it as a plain "
+      "number, without quotes: 190.4");
+  expect_landmark_error("landmarks:\n  a: [\"47.12\", 0, 0]\n",
+                        ":2:7: landmark 'a' coordinate must be a number, found the quoted text \"47.12\"");
+}
+
+// A landmark named like a muscle's insertion or origin was shadowed by the muscle's point, without a word
+// (a scenario refuses such an extra point as ambiguous).
+TEST(Landmarks, PointNamedLikeAMusclesInsertionIsRefusedAsAmbiguous) {
+  expect_landmark_error(
+      "landmarks:\n  m.insertion: [1, 2, 3]\nmuscles:\n  - {name: m, max_force_N: 1, insertion: [0, 0, 0], "
+      "origin: [0, 0, 1]}\n",
+      ":2:3: landmark 'm.insertion' has the name of the insertion of muscle 'm' (line 4), so the name would "
+      "be "
+      "ambiguous; rename it or use the muscle's insertion");
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: 1, insertion: [0, 0, 0], origin: [0, 0, 1]}\nlandmarks:\n  "
+      "m.origin: [1, 2, 3]\n",
+      ":4:3: landmark 'm.origin' has the name of the origin of muscle 'm' (line 2)");
+  // A dotted name of no muscle of the file is a name like any other.
+  const std::string path = test::temp_dir() + "/dotted.yaml";
+  test::write_file(path, "landmarks:\n  implant.insertion: [1, 2, 3]\n");
+  EXPECT_TRUE(read_landmarks(path).find("implant.insertion").has_value());
 }
 
 // Every option within its range, but together a short, wide ramus at the largest gonial angle made a bone
