@@ -840,6 +840,20 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
                                (m.origin && !m.origin->resolved && m.origin->name == m.name + ".origin") ||
                                !m.max_force_N;
     if (line == landmarks.muscles.end() && !m.pattern_key.empty()) {
+      // A landmark set with one side of the muscle only (a half jaw's file): the pattern key is right, the
+      // side is missing, so suggest the side that exists, with the activation the pattern gives it.
+      const bool left = m.name.rfind("left_", 0) == 0;
+      const std::string other_side = left ? "right" : "left";
+      const std::string other = other_side + "_" + m.pattern_key;
+      if (std::find(muscle_names.begin(), muscle_names.end(), other) != muscle_names.end()) {
+        const auto pattern_other = std::find_if(s.muscles.begin(), s.muscles.end(),
+                                                [&](const Muscle& o) { return o.name == other; });
+        fail(m.where, "activation_pattern key " + quote(m.pattern_key) + " makes " + m.name +
+                          ", but the landmarks have " + other + " only; activate that side alone (" +
+                          m.pattern_key + ": {" + other_side + ": " +
+                          fmt(pattern_other != s.muscles.end() ? pattern_other->activation : m.activation) +
+                          "}), or add " + m.name + " to the landmark file");
+      }
       // A pattern muscle takes everything from the landmarks: name the pattern key and the keys that exist.
       std::vector<std::string> bases;
       for (const std::string& name : muscle_names)
