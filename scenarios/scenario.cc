@@ -191,6 +191,15 @@ const std::vector<std::pair<std::string, MandibleVariant>> kVariants = {
     {"edentulous", MandibleVariant::kEdentulous},
     {"atrophic", MandibleVariant::kAtrophic}};
 
+// The `units` of a surface or CT geometry: the unit of the file's lengths.
+void read_units(const Map& map, GeometrySpec& g) {
+  if (auto x = map.find("units")) {
+    g.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
+    g.units_given = true;
+  }
+  g.scale_to_mm = unit_to_mm(g.units);
+}
+
 GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
   const Map map(v, {"mandible", "surface", "ct"});
   GeometrySpec g;
@@ -236,25 +245,25 @@ GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
     g.source = GeometrySource::kSurface;
     const Map s(map.get("surface"), {"file", "units"});
     g.file = resolve_file(ctx, s.require("file", "file: jaw.stl"), "surface");
-    if (auto x = s.find("units")) {
-      g.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
-    }
-    g.scale_to_mm = unit_to_mm(g.units);
+    read_units(s, g);
   } else {
     g.source = GeometrySource::kCt;
-    const Map c(map.get("ct"), {"file", "threshold", "series"});
+    const Map c(map.get("ct"), {"file", "threshold", "series", "units"});
     g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume", true);
     g.threshold =
         to_number(c.require("threshold", "threshold: 400 (the bone iso-value, e.g. in Hounsfield units)"));
     if (auto series = c.find("series")) g.dicom_series = to_string(*series);
+    read_units(c, g);
   }
   return g;
 }
 
 LandmarkSpec parse_landmarks(const Source& ctx, const std::optional<Value>& v, const GeometrySpec& geometry) {
   LandmarkSpec l;
-  // A landmark file lies in its surface's frame, so by default it shares the surface's unit.
-  l.scale_to_mm = geometry.source == GeometrySource::kSurface ? geometry.scale_to_mm : 1.0;
+  // A landmark file lies in its bone's frame, so by default it shares the unit written for the surface or
+  // CT volume.
+  if (geometry.source != GeometrySource::kMandible) l.units = geometry.units;
+  l.scale_to_mm = unit_to_mm(l.units);
   if (!v) return l;
   const Map map(*v, {"file", "units", "points"});
   l.where = v->at;
@@ -263,7 +272,8 @@ LandmarkSpec parse_landmarks(const Source& ctx, const std::optional<Value>& v, c
     if (!map.has("file"))
       fail(map.key_at("units"),
            "landmarks.units is given without landmarks.file; add the file or remove units");
-    l.scale_to_mm = unit_to_mm(to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}}));
+    l.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
+    l.scale_to_mm = unit_to_mm(l.units);
   }
   if (auto x = map.find("points")) {
     if (!x->node.IsNull() && !x->node.IsMap())
