@@ -148,8 +148,11 @@ Geometry build_geometry(const Scenario& s) {
   }
   if (!s.landmarks.file.empty()) {
     g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
-    const std::string fit = landmark_fit_warning(g.landmarks, g.surface, s.landmarks.file);
-    if (!fit.empty()) warn(s.landmarks.where.str() + ": " + fit);
+    for (const std::string& warning :
+         {landmark_fit_warning(g.landmarks, g.surface, s.landmarks.file, s.landmarks.units,
+                               "write units: <unit> in landmarks"),
+          landmark_side_warning(g.landmarks, s.landmarks.file)})
+      if (!warning.empty()) warn(s.landmarks.where.str() + ": " + warning);
   }
   return g;
 }

@@ -230,15 +230,25 @@ void write_landmarks(const std::string& path, const Landmarks& landmarks, const 
 }
 
 std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& surface,
-                                 const std::string& file) {
+                                 const std::string& file, const std::string& unit, const std::string& how) {
   if (landmarks.muscles.empty() || surface.triangles.empty()) return {};
   const SurfaceProjector projector(surface);
-  std::vector<std::pair<double, std::string>> off;  // (distance, muscle)
-  for (const MuscleLine& m : landmarks.muscles) off.emplace_back(projector.distance(m.insertion), m.name);
-  std::sort(off.begin(), off.end(), std::greater<>());
+  // The muscles by their insertions' distance to the surface, farthest first, with the coordinates scaled
+  // by `factor` (another reading of the file's unit).
+  const auto distances = [&](double factor) {
+    std::vector<std::pair<double, std::string>> off;  // (distance, muscle)
+    for (const MuscleLine& m : landmarks.muscles)
+      off.emplace_back(projector.distance(vec3::scale(m.insertion, factor)), m.name);
+    std::sort(off.begin(), off.end(), std::greater<>());
+    return off;
+  };
+  const auto median = [](const std::vector<std::pair<double, std::string>>& off) {
+    const std::size_t n = off.size();
+    return n % 2 ? off[n / 2].first : 0.5 * (off[n / 2 - 1].first + off[n / 2].first);
+  };
+  const auto off = distances(1.0);
   const std::size_t n = off.size();
-  const double median = n % 2 ? off[n / 2].first : 0.5 * (off[n / 2 - 1].first + off[n / 2].first);
-  if (median <= kLandmarkFitMedianMm) return {};
+  if (median(off) <= kLandmarkFitMedianMm) return {};
   std::string farthest;
   for (std::size_t i = 0; i < std::min<std::size_t>(3, n); ++i) {
     char item[160];
@@ -247,11 +257,62 @@ std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& s
   }
   char text[200];
   std::snprintf(text, sizeof text, "its %zu muscle insertions lie a median %.1f mm from the surface", n,
-                median);
+                median(off));
+  std::string advice =
+      "check that the file was written for this surface and in its frame (+x the subject's left, +y "
+      "posterior, +z superior)";
+  for (const char* other : {"mm", "cm", "m"}) {
+    if (other == unit) continue;
+    const double fit = median(distances(unit_to_mm(other) / unit_to_mm(unit)));
+    if (fit > kLandmarkFitMedianMm) continue;
+    std::string fix = how;
+    for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
+      fix.replace(at, 6, other);
+    char read[160];
+    std::snprintf(read, sizeof read, "read in %s, they lie a median %.1f mm from it: ", other, fit);
+    advice = read + fix;
+    break;
+  }
   return "landmark file " + file + ": " + text +
          " (they lie on the bone, within about 1 mm, when the file belongs to it); farthest: " + farthest +
-         ". Placements and patches built from it will be off: check that the file was written for this "
-         "surface, in its frame and units";
+         ". Placements and patches built from it will be off; " + advice;
+}
+
+std::vector<LeftRightPair> left_right_pairs(const Landmarks& landmarks) {
+  std::map<std::string, Vec3> located = landmarks.points;  // points and insertions, by name
+  for (const MuscleLine& m : landmarks.muscles) located.emplace(m.name + ".insertion", m.insertion);
+  std::vector<LeftRightPair> pairs;
+  for (const auto& [name, left] : located) {
+    if (name.rfind("left_", 0) != 0) continue;
+    const auto right = located.find("right_" + name.substr(5));
+    if (right != located.end()) pairs.push_back({name, left, right->second});
+  }
+  return pairs;
+}
+
+std::string landmark_side_warning(const Landmarks& landmarks, const std::string& file) {
+  const std::vector<LeftRightPair> pairs = left_right_pairs(landmarks);
+  std::vector<const LeftRightPair*> swapped;  // left_ points at smaller x than their partners
+  for (const LeftRightPair& p : pairs)
+    if (p.left[0] < p.right[0]) swapped.push_back(&p);
+  if (swapped.empty()) return {};
+  // Named: the pair farthest apart, the plainest sign of a swap (insertions near the midline may cross).
+  const LeftRightPair& first =
+      **std::max_element(swapped.begin(), swapped.end(), [](const LeftRightPair* a, const LeftRightPair* b) {
+        return a->right[0] - a->left[0] < b->right[0] - b->left[0];
+      });
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "%s lies at x = %.1f mm, at smaller x than its partner right_%s (x = %.1f mm)",
+                first.left_name.c_str(), first.left[0], first.left_name.substr(5).c_str(), first.right[0]);
+  return "landmark file " + file + ": " + text +
+         (swapped.size() > 1 ? " (and " + std::to_string(swapped.size() - 1) + " more of its " +
+                                   std::to_string(pairs.size()) + " left/right pairs)"
+                             : std::string()) +
+         ", but the frame has +x on the subject's left, so left_ points lie at larger x than their right_ "
+         "partners: the file's sides are swapped or mirrored, and a bite or muscle of one side would act "
+         "on the other. Check the file's frame (+x the subject's left, +y posterior, +z superior), or "
+         "swap left_ and right_ in its names";
 }
 
 }  // namespace hexbite

@@ -325,21 +325,51 @@ TEST(Landmarks, ReadsTheSharedRealJawFile) {
 // by it landed 6.4-6.7 mm off the bone. Each file fits its own bone (median insertion distance 0 mm on the
 // built-in mandible, 0.5 mm on the real jaw) and is flagged on the other (2.9 and 3.2 mm).
 TEST(Landmarks, AFileOfAnotherMandibleIsFlaggedAndItsOwnIsNot) {
+  const std::string kHow = "write units: <unit> in landmarks";
   const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
   const Landmarks jaw_landmarks = read_landmarks(jaw_file);
   const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
   const GeneratedMandible& built_in = generated(MandibleVariant::kDentate);
-  EXPECT_EQ(landmark_fit_warning(jaw_landmarks, jaw, jaw_file), "");
-  EXPECT_EQ(landmark_fit_warning(built_in.landmarks, built_in.surface, "m.yaml"), "");
-  const std::string on_jaw = landmark_fit_warning(built_in.landmarks, jaw, "m.yaml");
+  EXPECT_EQ(landmark_fit_warning(jaw_landmarks, jaw, jaw_file, "mm", kHow), "");
+  EXPECT_EQ(landmark_fit_warning(built_in.landmarks, built_in.surface, "m.yaml", "mm", kHow), "");
+  const std::string on_jaw = landmark_fit_warning(built_in.landmarks, jaw, "m.yaml", "mm", kHow);
   EXPECT_NE(on_jaw.find("landmark file m.yaml: its 18 muscle insertions lie a median 2."), std::string::npos)
       << on_jaw;
   EXPECT_NE(on_jaw.find("deep_masseter"), std::string::npos) << on_jaw;
-  const std::string on_built_in = landmark_fit_warning(jaw_landmarks, built_in.surface, jaw_file);
+  const std::string on_built_in = landmark_fit_warning(jaw_landmarks, built_in.surface, jaw_file, "mm", kHow);
   EXPECT_NE(on_built_in.find("anterior_temporalis"), std::string::npos) << on_built_in;
-  // A file in cm read as mm is off by far more.
+  EXPECT_NE(on_jaw.find("; check that the file was written for this surface and in its frame"),
+            std::string::npos)
+      << on_jaw;
+  // A file in cm read as mm is off by far more. The warning said only "check ... its frame and units"; read
+  // in cm it fits, and the warning says so and how to give the unit.
   const Landmarks cm = read_landmarks(jaw_file, 0.1);
-  EXPECT_NE(landmark_fit_warning(cm, jaw, jaw_file), "");
+  const std::string in_cm = landmark_fit_warning(cm, jaw, jaw_file, "mm", kHow);
+  EXPECT_NE(in_cm.find(" will be off; read in cm, they lie a median 0."), std::string::npos) << in_cm;
+  EXPECT_NE(in_cm.find("mm from it: write units: cm in landmarks"), std::string::npos) << in_cm;
+}
+
+// A file with left and right swapped (x negated) fits the nearly symmetric bone as well as the right one and
+// was taken without a word: the bite then lands on the other side. The real jaw's and the built-in
+// mandible's files (which the shipped scenarios use) keep their sides; the mirrored ones are warned of.
+TEST(Landmarks, SwappedSidesAreWarnedOfNamingAPair) {
+  const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
+  const Landmarks jaw = read_landmarks(jaw_file);
+  EXPECT_EQ(landmark_side_warning(jaw, jaw_file), "");
+  for (MandibleVariant variant :
+       {MandibleVariant::kDentate, MandibleVariant::kEdentulous, MandibleVariant::kAtrophic})
+    EXPECT_EQ(landmark_side_warning(generated(variant).landmarks, "m.yaml"), "");
+  Landmarks mirrored = jaw;
+  for (auto& [name, p] : mirrored.points) p[0] = -p[0];
+  for (MuscleLine& m : mirrored.muscles) m.insertion[0] = -m.insertion[0];
+  const std::string warning = landmark_side_warning(mirrored, "m.yaml");
+  // Named by the pair farthest apart: the condyles, not insertions near the midline.
+  EXPECT_NE(warning.find("landmark file m.yaml: left_condyle_tmj_point lies at x = -51.8 mm, at smaller x "
+                         "than its partner right_condyle_tmj_point (x = 51.8 mm)"),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("(and 10 more of its 11 left/right pairs)"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("swap left_ and right_ in its names"), std::string::npos) << warning;
 }
 
 void expect_landmark_error(const std::string& contents, const std::string& expected_fragment) {
