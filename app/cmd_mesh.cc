@@ -358,7 +358,8 @@ void add_mesh_command(CLI::App& app) {
                   "elements) or .msh (Gmsh 4.1)")
       ->required()
       ->check(output_hex_mesh_file());
-  cmd->add_option("--units", o->units, "Length unit of the surface file: mm, cm or m")->default_val("mm");
+  cmd->add_option("--units", o->units, "Length unit of the surface and landmark files: mm, cm or m")
+      ->default_val("mm");
   cmd->add_option("--margin", o->margin,
                   "Core cells of the overlay grid (--method grid) have their centre at least this many "
                   "cell sizes inside the surface (negative: at most that far outside), on every grid; the "

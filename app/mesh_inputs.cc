@@ -28,8 +28,13 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
   in.surface = load_surface_input(surface_file, units);
   if (landmark_file.empty()) return in;
   in.landmarks = std::make_unique<Landmarks>(read_landmarks(landmark_file, unit_to_mm(units)));
-  const std::string fit_warning = landmark_fit_warning(*in.landmarks, in.surface, landmark_file);
-  if (!fit_warning.empty()) std::cerr << "hexbite: warning: " << fit_warning << ".\n";
+  // --units reads both files; a landmark file in another unit than the surface must be converted.
+  const std::string how =
+      "convert the landmark file to the surface's unit, " + units + " (--units reads both files in it)";
+  for (const std::string& warning :
+       {landmark_fit_warning(*in.landmarks, in.surface, landmark_file, units, how),
+        landmark_side_warning(*in.landmarks, landmark_file)})
+    if (!warning.empty()) std::cerr << "hexbite: warning: " << warning << ".\n";
   return in;
 }
 

@@ -1,8 +1,9 @@
 // The inputs of the commands that read a triangulated bone (`mesh SURFACE --method grid|sheets`, `quad
 // from-mandible`, `surface clean`, `refine --surface`): the SURFACE, closed and in millimetres, and for the
 // meshing commands the optional --landmarks file in the same unit. Each gets a warning on standard error when
-// it does not fit: a size no mandible has (a file in metres read as millimetres), or a landmark file written
-// for another bone, frame or unit (landmark_fit_warning()). Errors (unreadable, open or non-manifold
+// it does not fit: a size no mandible has (a file in metres read as millimetres), a landmark file written
+// for another bone, frame or unit (landmark_fit_warning()) or with its sides swapped
+// (landmark_side_warning()). Errors (unreadable, open or non-manifold
 // surfaces, malformed landmark files) are InputErrors from the loaders.
 #pragma once
 

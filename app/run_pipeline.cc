@@ -58,7 +58,19 @@ constexpr long long kDirectSolverMaxDofs = 30000;
 struct Geometry {
   TriSurface surface;
   Landmarks landmarks;
+  std::string volume_unit;  // a CT volume: the unit its file states (VolumeInfo::length_unit)
 };
+
+// A CT volume's lengths as `units` (mm, cm, m) read them, where the reader took them in `stated` (the unit
+// the file states, or mm when it states none), so that `geometry.ct.units` holds for any file.
+void rescale_to_units(VoxelVolume& volume, const std::string& stated, const std::string& units) {
+  const double factor = unit_to_mm(units) / stated_unit_to_mm(stated);
+  for (int a = 0; a < 3; ++a) {
+    volume.origin[a] *= factor;
+    volume.axis_spacing[a] *= factor;
+  }
+  volume.spacing *= factor;
+}
 
 // A warning on standard error, from rank 0 only (every rank builds the same geometry).
 void warn(const std::string& line) {
@@ -90,8 +102,10 @@ Geometry build_geometry(const Scenario& s) {
       CtExtraction dropped;
       VolumeInfo source;
       try {
-        g.surface = surface_from_volume(read_volume(s.geometry.file, &source, s.geometry.dicom_series),
-                                        s.geometry.threshold, &dropped);
+        VoxelVolume volume = read_volume(s.geometry.file, &source, s.geometry.dicom_series);
+        g.volume_unit = source.length_unit;
+        if (s.geometry.units_given) rescale_to_units(volume, source.length_unit, s.geometry.units);
+        g.surface = surface_from_volume(volume, s.geometry.threshold, &dropped);
       } catch (const InputError& e) {
         const std::string what = e.what();
         // read_volume names the file; the threshold's messages speak of "the volume".
@@ -115,18 +129,30 @@ Geometry build_geometry(const Scenario& s) {
       break;
     }
   }
-  if (s.geometry.source == GeometrySource::kSurface && !g.surface.vertices.empty()) {
+  if (s.geometry.source != GeometrySource::kMandible && !g.surface.vertices.empty()) {
     // A file in centimetres read as millimetres (a mandible of 12 mm) solves without complaint, stresses a
-    // hundred times too large; so does one in mm read as m. The bounds are those of a mandible.
+    // hundred times too large; so does one in mm read as m. The bounds are those of a mandible. A CT
+    // volume's lengths are in the unit its file states (a NIfTI header, DICOM's mm) unless `units` says
+    // otherwise; a MetaImage states none.
+    const bool ct = s.geometry.source == GeometrySource::kCt;
+    const std::string read_as =
+        !ct || s.geometry.units_given || g.volume_unit.empty() ? s.geometry.units : g.volume_unit;
     const std::string size_warning = unit_mismatch_warning(
-        largest_extent(g.surface), s.geometry.units,
-        "write units: <unit> in geometry.surface (a landmarks.file without units of its own follows it)");
+        largest_extent(g.surface), read_as,
+        std::string("write units: <unit> in geometry.") + (ct ? "ct" : "surface") + " (" +
+            (ct && !g.volume_unit.empty() && !s.geometry.units_given
+                 ? "it overrides the unit the file states, " + g.volume_unit + "; "
+                 : "") +
+            "a landmarks.file without units of its own follows it)");
     if (!size_warning.empty()) warn(s.geometry.where.str() + ": " + s.geometry.file + ": " + size_warning);
   }
   if (!s.landmarks.file.empty()) {
     g.landmarks = read_landmarks(s.landmarks.file, s.landmarks.scale_to_mm);
-    const std::string fit = landmark_fit_warning(g.landmarks, g.surface, s.landmarks.file);
-    if (!fit.empty()) warn(s.landmarks.where.str() + ": " + fit);
+    for (const std::string& warning :
+         {landmark_fit_warning(g.landmarks, g.surface, s.landmarks.file, s.landmarks.units,
+                               "write units: <unit> in landmarks"),
+          landmark_side_warning(g.landmarks, s.landmarks.file)})
+      if (!warning.empty()) warn(s.landmarks.where.str() + ": " + warning);
   }
   return g;
 }

@@ -459,6 +459,7 @@ VoxelVolume volume_from_dicom(const std::string& folder, VolumeInfo* info, const
                                (series.modality.empty() ? std::string("not given") : series.modality) +
                                ", not CT: the threshold is in its own units, not Hounsfield units");
   }
+  if (info) info->length_unit = "mm";  // DICOM's patient frame is in mm
   VoxelVolume v;
   v.dims = series.dims;
   v.values = std::move(series.values);
@@ -537,16 +538,23 @@ VoxelVolume read_volume(const std::string& path, VolumeInfo* info, const std::st
     }
     // NIfTI may give lengths in metres or micrometres (xyzt_units); hexbite works in millimetres.
     if (vtkNIFTIImageHeader* header = reader->GetNIFTIHeader()) {
+      std::string unit;
       switch (header->GetXYZTUnits() & 0x07) {
         case vtkNIFTIImageHeader::UnitsMeter:
           length_scale = 1000;
+          unit = "m";
           break;
         case vtkNIFTIImageHeader::UnitsMicron:
           length_scale = 0.001;
+          unit = "um";
+          break;
+        case vtkNIFTIImageHeader::UnitsMM:
+          unit = "mm";
           break;
         default:
-          break;  // millimetres, or unknown (0): taken as millimetres
+          break;  // unknown (0): taken as millimetres
       }
+      if (info) info->length_unit = unit;
     }
   }
   if (!errors.message.empty() || !image || !image->GetPointData()->GetScalars())

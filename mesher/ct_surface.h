@@ -13,6 +13,10 @@ namespace hexbite {
 struct VolumeInfo {
   std::string description;  // a DICOM series: "DICOM series 'BONE 0.6' (CT), 318 slices"; else empty
   std::vector<std::string> warnings;  // sentences: files of the folder left out, a series that is no CT
+  // The unit the file states for its lengths, into which the reader has converted them to mm: "mm" for a
+  // DICOM series (the standard's) and a NIfTI whose xyzt_units says so, "m" or "um" for a NIfTI in metres
+  // or micrometres; empty for a file that states none (MetaImage, NIfTI unit code 0), read as mm.
+  std::string length_unit;
 };
 
 // Reads MetaImage (.mha/.mhd), NIfTI (.nii/.nii.gz) or, given a folder, the DICOM series in it

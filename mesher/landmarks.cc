@@ -16,6 +16,8 @@
 #include "common/suggestion.h"
 #include "mesher/surface_projector.h"
 #include "mesher/units.h"
+#include "mesher/vec3.h"
+#include "mesher/yaml_scalars.h"
 
 namespace hexbite {
 
@@ -41,13 +43,11 @@ void claim_name(const std::string& path, const YAML::Mark& mark, const std::stri
              "; keep one");
 }
 
+// Numbers as a scenario takes them: plain, not quoted (yaml_scalars.h).
 double read_number(const std::string& path, const YAML::Node& node, const std::string& what) {
-  if (!node.IsScalar()) fail(path, node.Mark(), what + " must be a number");
-  double value = 0;
-  if (!YAML::convert<double>::decode(node, value))
-    fail(path, node.Mark(), what + " must be a number, not '" + node.Scalar() + "'");
-  if (!std::isfinite(value)) fail(path, node.Mark(), what + " is not finite ('" + node.Scalar() + "')");
-  return value;
+  const std::optional<double> value = plain_number(node);
+  if (!value) fail(path, node.Mark(), what + " must be a number, " + number_expected(node));
+  return *value;
 }
 
 // A point in mm, each coordinate within kMaxCoordinateMm like a scenario's own (scenarios/scenario.cc), also
@@ -133,6 +133,12 @@ std::string format_number(double v) {
 
 }  // namespace
 
+std::string ambiguous_name_text(const std::string& point, const std::string& other,
+                                const std::string& other_short) {
+  return point + " has the name of " + other + ", so the name would be ambiguous; rename it or use " +
+         other_short;
+}
+
 std::optional<Vec3> Landmarks::find(const std::string& name) const {
   if (auto it = points.find(name); it != points.end()) return it->second;
   const auto dot = name.rfind('.');
@@ -160,7 +166,8 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
   if (!root.IsMap()) fail(path, root.Mark(), "expected a map with 'landmarks:' and 'muscles:'");
 
   Landmarks out;
-  std::map<std::string, int> names;  // name -> the 1-based line where it is first given
+  std::map<std::string, int> names;               // name -> the 1-based line where it is first given
+  std::map<std::string, YAML::Mark> point_marks;  // landmark name -> its key
   try {
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();
@@ -171,6 +178,7 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
         for (const auto& lm : value) {
           const std::string name = lm.first.as<std::string>();
           claim_name(path, lm.first.Mark(), name, names);
+          point_marks.emplace(name, lm.first.Mark());
           out.points[name] = read_point(path, lm.second, "landmark '" + name + "'", scale_to_mm);
         }
       } else if (key == "muscles") {
@@ -186,6 +194,19 @@ Landmarks read_landmarks(const std::string& path, double scale_to_mm) {
                                   "reorder` in millimetres"
                                 : suggestion(key, {"landmarks", "muscles"}, "sections")));
       }
+    }
+    // Landmarks::find and a scenario take "<muscle>.insertion" for the muscle's point, so a landmark of
+    // that name would be silently shadowed by it.
+    for (const auto& [name, mark] : point_marks) {
+      const auto dot = name.rfind('.');
+      if (dot == std::string::npos) continue;
+      const std::string muscle = name.substr(0, dot), part = name.substr(dot + 1);
+      if ((part == "insertion" || part == "origin") && names.count(muscle) && !out.points.count(muscle))
+        fail(path, mark,
+             ambiguous_name_text("landmark '" + name + "'",
+                                 "the " + part + " of muscle '" + muscle + "' (line " +
+                                     std::to_string(names.at(muscle)) + ")",
+                                 "the muscle's " + part));
     }
   } catch (const YAML::Exception& e) {
     // Keys that are not scalars (e.g. a list used as a key) end up here; yaml-cpp says only "bad conversion".
@@ -208,15 +229,25 @@ void write_landmarks(const std::string& path, const Landmarks& landmarks, const 
 }
 
 std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& surface,
-                                 const std::string& file) {
+                                 const std::string& file, const std::string& unit, const std::string& how) {
   if (landmarks.muscles.empty() || surface.triangles.empty()) return {};
   const SurfaceProjector projector(surface);
-  std::vector<std::pair<double, std::string>> off;  // (distance, muscle)
-  for (const MuscleLine& m : landmarks.muscles) off.emplace_back(projector.distance(m.insertion), m.name);
-  std::sort(off.begin(), off.end(), std::greater<>());
+  // The muscles by their insertions' distance to the surface, farthest first, with the coordinates scaled
+  // by `factor` (another reading of the file's unit).
+  const auto distances = [&](double factor) {
+    std::vector<std::pair<double, std::string>> off;  // (distance, muscle)
+    for (const MuscleLine& m : landmarks.muscles)
+      off.emplace_back(projector.distance(vec3::scale(m.insertion, factor)), m.name);
+    std::sort(off.begin(), off.end(), std::greater<>());
+    return off;
+  };
+  const auto median = [](const std::vector<std::pair<double, std::string>>& off) {
+    const std::size_t n = off.size();
+    return n % 2 ? off[n / 2].first : 0.5 * (off[n / 2 - 1].first + off[n / 2].first);
+  };
+  const auto off = distances(1.0);
   const std::size_t n = off.size();
-  const double median = n % 2 ? off[n / 2].first : 0.5 * (off[n / 2 - 1].first + off[n / 2].first);
-  if (median <= kLandmarkFitMedianMm) return {};
+  if (median(off) <= kLandmarkFitMedianMm) return {};
   std::string farthest;
   for (std::size_t i = 0; i < std::min<std::size_t>(3, n); ++i) {
     char item[160];
@@ -225,11 +256,62 @@ std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& s
   }
   char text[200];
   std::snprintf(text, sizeof text, "its %zu muscle insertions lie a median %.1f mm from the surface", n,
-                median);
+                median(off));
+  std::string advice =
+      "check that the file was written for this surface and in its frame (+x the subject's left, +y "
+      "posterior, +z superior)";
+  for (const char* other : {"mm", "cm", "m"}) {
+    if (other == unit) continue;
+    const double fit = median(distances(unit_to_mm(other) / unit_to_mm(unit)));
+    if (fit > kLandmarkFitMedianMm) continue;
+    std::string fix = how;
+    for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
+      fix.replace(at, 6, other);
+    char read[160];
+    std::snprintf(read, sizeof read, "read in %s, they lie a median %.1f mm from it: ", other, fit);
+    advice = read + fix;
+    break;
+  }
   return "landmark file " + file + ": " + text +
          " (they lie on the bone, within about 1 mm, when the file belongs to it); farthest: " + farthest +
-         ". Placements and patches built from it will be off: check that the file was written for this "
-         "surface, in its frame and units";
+         ". Placements and patches built from it will be off; " + advice;
+}
+
+std::vector<LeftRightPair> left_right_pairs(const Landmarks& landmarks) {
+  std::map<std::string, Vec3> located = landmarks.points;  // points and insertions, by name
+  for (const MuscleLine& m : landmarks.muscles) located.emplace(m.name + ".insertion", m.insertion);
+  std::vector<LeftRightPair> pairs;
+  for (const auto& [name, left] : located) {
+    if (name.rfind("left_", 0) != 0) continue;
+    const auto right = located.find("right_" + name.substr(5));
+    if (right != located.end()) pairs.push_back({name, left, right->second});
+  }
+  return pairs;
+}
+
+std::string landmark_side_warning(const Landmarks& landmarks, const std::string& file) {
+  const std::vector<LeftRightPair> pairs = left_right_pairs(landmarks);
+  std::vector<const LeftRightPair*> swapped;  // left_ points at smaller x than their partners
+  for (const LeftRightPair& p : pairs)
+    if (p.left[0] < p.right[0]) swapped.push_back(&p);
+  if (swapped.empty()) return {};
+  // Named: the pair farthest apart, the plainest sign of a swap (insertions near the midline may cross).
+  const LeftRightPair& first =
+      **std::max_element(swapped.begin(), swapped.end(), [](const LeftRightPair* a, const LeftRightPair* b) {
+        return a->right[0] - a->left[0] < b->right[0] - b->left[0];
+      });
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "%s lies at x = %.1f mm, at smaller x than its partner right_%s (x = %.1f mm)",
+                first.left_name.c_str(), first.left[0], first.left_name.substr(5).c_str(), first.right[0]);
+  return "landmark file " + file + ": " + text +
+         (swapped.size() > 1 ? " (and " + std::to_string(swapped.size() - 1) + " more of its " +
+                                   std::to_string(pairs.size()) + " left/right pairs)"
+                             : std::string()) +
+         ", but the frame has +x on the subject's left, so left_ points lie at larger x than their right_ "
+         "partners: the file's sides are swapped or mirrored, and a bite or muscle of one side would act "
+         "on the other. Check the file's frame (+x the subject's left, +y posterior, +z superior), or "
+         "swap left_ and right_ in its names";
 }
 
 }  // namespace hexbite

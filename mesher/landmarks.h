@@ -31,6 +31,12 @@ struct Landmarks {
   std::optional<Vec3> find(const std::string& name) const;
 };
 
+// The refusal of a point whose name is another's: "<point> has the name of <other>, so the name would be
+// ambiguous; rename it or use <other_short>" (a scenario's extra point named like a landmark, a landmark
+// named like a muscle's insertion).
+std::string ambiguous_name_text(const std::string& point, const std::string& other,
+                                const std::string& other_short);
+
 // Throws InputError naming the file and line for malformed files.
 Landmarks read_landmarks(const std::string& path, double scale_to_mm = 1.0);
 // Written atomically with a header comment giving the frame; deterministic.
@@ -41,9 +47,26 @@ void write_landmarks(const std::string& path, const Landmarks& landmarks, const 
 // bone, frame or unit leaves them off this surface: a mandible's file on a similar mandible in the same frame
 // puts them a median 2-3 mm away, and the template then lands 6-7 mm off. Returns an empty string when the
 // median insertion distance is at most kLandmarkFitMedianMm (or the file has no muscles), else a warning
-// naming the file, the median and the farthest insertions, and what to check.
+// naming the file, the median and the farthest insertions, and what to do: when the file read in another
+// of mm, cm and m than `unit` (the one it was read in) fits, that unit and `how` to give it ("<unit>" in it
+// is replaced by the unit, e.g. "write units: <unit> in landmarks"), else to check its surface and frame.
 constexpr double kLandmarkFitMedianMm = 1.5;
 std::string landmark_fit_warning(const Landmarks& landmarks, const TriSurface& surface,
-                                 const std::string& file);
+                                 const std::string& file, const std::string& unit, const std::string& how);
+
+// The left_<name> / right_<name> pairs among the points and muscle insertions ("<muscle>.insertion"), by
+// the left name: the mirror pairs of a mandible's landmarks.
+struct LeftRightPair {
+  std::string left_name;
+  Vec3 left, right;
+};
+std::vector<LeftRightPair> left_right_pairs(const Landmarks& landmarks);
+
+// Whether a landmark file's sides are those of the frame (+x the subject's left): a file with left and
+// right swapped, or mirrored in x, fits the bone as well as the right one (a mandible is nearly
+// symmetric), so landmark_fit_warning does not see it, and the bite lands on the other side. Returns an
+// empty string when every left_<name> point and muscle insertion lies at larger x than its right_<name>
+// partner, else a warning naming the file, the pair farthest apart at smaller x and how many more are so.
+std::string landmark_side_warning(const Landmarks& landmarks, const std::string& file);
 
 }  // namespace hexbite

@@ -402,8 +402,9 @@ Correspondence correspond(const MandibleQuadTemplate& t, const TriSurface& surfa
       if (it == target.end())
         throw InputError(
             "the surface has no points on both sides of x = 0, so it is not a mandible in the "
-            "generator's frame (+x subject's left); give " +
-            terms.landmarks + " or use " + terms.grid_method);
+            "generator's frame (+x subject's left): placed by extreme points, the template needs the "
+            "bone's midline at x = 0. Move the bone so that its midline is x = 0, give " +
+            terms.landmarks + " (which place it wherever the bone lies), or use " + terms.grid_method);
       c.names.push_back(name);
       c.sources.push_back(p);
       c.targets.push_back(it->second);
@@ -431,27 +432,50 @@ Correspondence correspond(const MandibleQuadTemplate& t, const TriSurface& surfa
   if (c.names.size() < 6 || !left || !right || !front) {
     std::string list;
     for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
-    throw InputError("landmark file " + file + ": only " + std::to_string(c.names.size()) +
-                     " of the points that place the mandible template are in it (at least 6 are needed, on "
-                     "both rami and at the front); missing: " +
-                     list + ". Write them as 'hexbite generate mandible --landmarks' does, or leave out " +
-                     terms.landmarks + " to place the template by extreme points");
+    // Name what is lacking: a file of one side only has enough points, but none on the other ramus.
+    std::string unpinned;
+    for (const auto& [pinned, where] : {std::pair<bool, const char*>{left, "on the left ramus"},
+                                        {right, "on the right ramus"},
+                                        {front, "at the front"}})
+      if (!pinned) unpinned += std::string(unpinned.empty() ? "" : " or ") + where;
+    const std::string count = std::to_string(c.names.size());
+    throw InputError(
+        "landmark file " + file + ": " + (c.names.size() < 6 ? "only " + count : count) +
+        " of the points that place the mandible template are in it" +
+        (unpinned.empty() ? "" : (c.names.size() < 6 ? ", and" : ", but") + (" no point " + unpinned)) +
+        " (at least 6 are needed, on both rami and at the front); missing: " + list +
+        ". Write them as 'hexbite generate mandible --landmarks' does, or leave out " + terms.landmarks +
+        " to place the template by extreme points");
   }
   return c;
+}
+
+// The x of the bone's midline by its landmarks: the mean of the midpoints of the left_<name> and
+// right_<name> points and muscle insertions, so that a bone placed anywhere along x (not only about x = 0,
+// as the built-in mandible and the real jaw are) gets its points derived on the right sides. 0 without
+// landmarks (extreme points need the midline at x = 0) or pairs. Exactly 0 for a file mirrored in x.
+double landmark_midline_x(const Landmarks* landmarks) {
+  if (!landmarks) return 0;
+  const std::vector<LeftRightPair> pairs = left_right_pairs(*landmarks);
+  double sum = 0;
+  for (const LeftRightPair& p : pairs) sum += 0.5 * (p.left[0] + p.right[0]);
+  return pairs.empty() ? 0.0 : sum / pairs.size();
 }
 
 // Points derived from the surface's shape where landmark files have none but the template needs guidance:
 // per side the top of the condyle, the top of the coronoid process and the bottom of the sigmoid notch
 // between them (the notch depth varies much between mandibles). Searched among the surface vertices near
-// where the first warp puts the default mandible's points; names as in MandibleQuadTemplate::derived.
+// where the first warp puts the default mandible's points, the sides told apart by the midline at
+// `midline_x`; names as in MandibleQuadTemplate::derived.
 std::map<std::string, Vec3> derive_points(const TriSurface& surface, const MandibleQuadTemplate& t,
-                                          const ThinPlateSpline& warp) {
+                                          const ThinPlateSpline& warp, double midline_x) {
   std::map<std::string, Vec3> out;
   // The highest vertex on one side (beyond 20 mm from the midline) within dy of around's y.
   auto highest = [&](const Vec3& around, double side, double dy) {
     const Vec3* best = nullptr;
     for (const Vec3& v : surface.vertices)
-      if (side * v[0] > 20.0 && std::abs(v[1] - around[1]) < dy && (!best || v[2] > (*best)[2])) best = &v;
+      if (side * (v[0] - midline_x) > 20.0 && std::abs(v[1] - around[1]) < dy && (!best || v[2] > (*best)[2]))
+        best = &v;
     return best;
   };
   for (const auto& [side, sign] : {std::pair<std::string, double>{"left_", 1.0}, {"right_", -1.0}}) {
@@ -464,7 +488,7 @@ std::map<std::string, Vec3> derive_points(const TriSurface& surface, const Mandi
     const int bins = static_cast<int>(std::ceil(y1 - y0));
     std::vector<const Vec3*> top(static_cast<std::size_t>(bins), nullptr);
     for (const Vec3& v : surface.vertices) {
-      if (sign * v[0] <= 0 || std::abs(v[0] - xm) > 12.0 || v[1] < y0 || v[1] >= y1) continue;
+      if (sign * (v[0] - midline_x) <= 0 || std::abs(v[0] - xm) > 12.0 || v[1] < y0 || v[1] >= y1) continue;
       const int b = std::min(bins - 1, static_cast<int>(v[1] - y0));
       if (!top[b] || v[2] > (*top[b])[2]) top[b] = &v;
     }
@@ -486,7 +510,8 @@ std::map<std::string, Vec3> derive_points(const TriSurface& surface, const Mandi
   const Vec3 incisal = warp(t.derived.at("incisal_top"));
   const Vec3* top = nullptr;
   for (const Vec3& v : surface.vertices)
-    if (std::abs(v[0]) < 4.0 && std::abs(v[1] - incisal[1]) < 10.0 && (!top || v[2] > (*top)[2])) top = &v;
+    if (std::abs(v[0] - midline_x) < 4.0 && std::abs(v[1] - incisal[1]) < 10.0 && (!top || v[2] > (*top)[2]))
+      top = &v;
   if (top) out["incisal_top"] = *top;
   return out;
 }
@@ -1330,7 +1355,8 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
                                                                         : options.landmark_smoothing_mm;
   const ThinPlateSpline first_warp(corr.sources, corr.targets, lambda);
   Correspondence all = corr;
-  const std::map<std::string, Vec3> features = derive_points(surface, tmpl, first_warp);
+  const std::map<std::string, Vec3> features =
+      derive_points(surface, tmpl, first_warp, landmark_midline_x(landmarks));
   for (const auto& [name, p] : features) {
     all.names.push_back(name);
     all.sources.push_back(tmpl.derived.at(name));

@@ -15,6 +15,11 @@ double unit_to_mm(const std::string& unit) {
   throw InputError("unknown length unit '" + unit + "': use one of mm, cm, m");
 }
 
+double stated_unit_to_mm(const std::string& unit) {
+  if (unit == "um") return 0.001;
+  return unit.empty() ? 1.0 : unit_to_mm(unit);
+}
+
 namespace {
 
 // The shared sentence of the two size warnings: the size as read, and the unit among mm, cm and m whose
@@ -24,7 +29,7 @@ namespace {
 std::string size_warning(double largest_extent_mm, const std::string& unit, double lo, double hi,
                          bool say_only, const std::string& how) {
   if (!(largest_extent_mm < lo || largest_extent_mm > hi)) return {};
-  const double in_file_units = largest_extent_mm / unit_to_mm(unit);
+  const double in_file_units = largest_extent_mm / stated_unit_to_mm(unit);
   std::string best;
   double best_size = 0;
   for (const char* candidate : {"mm", "cm", "m"}) {

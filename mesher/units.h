@@ -15,6 +15,9 @@ constexpr double kMaxCoordinateMm = 1e6;
 // Factor that converts a length in `unit` (mm, cm or m) to millimetres.
 // Throws InputError naming the accepted units for anything else.
 double unit_to_mm(const std::string& unit);
+// The same for the unit a volume file states (VolumeInfo::length_unit): also "um" (a NIfTI may state
+// micrometres, which no option or key offers) and "" (no unit stated: read as mm).
+double stated_unit_to_mm(const std::string& unit);
 
 // A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m) has a size
 // no bone has: its largest side, `largest_extent_mm` after the conversion, under 0.5 mm (a bone exported in
@@ -26,12 +29,12 @@ double unit_to_mm(const std::string& unit);
 std::string implausible_size_warning(double largest_extent_mm, const std::string& unit,
                                      const std::string& how);
 
-// A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m) is
-// implausibly sized for a mandible: its largest side, `largest_extent_mm` after the conversion, under 20 mm
-// or over 500 mm (a file in centimetres read as millimetres gives a mandible of about 12 mm, which
-// implausible_size_warning lets pass). Names the unit among mm, cm and m that would give a size near 100 mm,
-// and `how` to give it (e.g. "write units: cm in geometry.surface"; "<unit>" in it is replaced by the unit).
-// Empty for plausible sizes.
+// A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m, or um for
+// a NIfTI volume that states micrometres) is implausibly sized for a mandible: its largest side,
+// `largest_extent_mm` after the conversion, under 20 mm or over 500 mm (a file in centimetres read as
+// millimetres gives a mandible of about 12 mm, which implausible_size_warning lets pass). Names the unit
+// among mm, cm and m that would give a size near 100 mm, and `how` to give it (e.g. "write units: cm in
+// geometry.surface"; "<unit>" in it is replaced by the unit). Empty for plausible sizes.
 std::string unit_mismatch_warning(double largest_extent_mm, const std::string& unit, const std::string& how);
 
 // A point in millimetres for a message, to a tenth of a millimetre: "(12.3, -4.0, 56.7) mm".

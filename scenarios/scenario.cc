@@ -75,14 +75,9 @@ std::vector<std::string> closest_names(const std::string& given, const std::vect
 }
 
 double to_number(const Value& v) {
-  double x = 0;
-  if (!v.node.IsScalar() || is_quoted(v.node) || !YAML::convert<double>::decode(v.node, x) ||
-      !std::isfinite(x))
-    fail(v.at, v.path + " must be a number, found " + describe(v.node) +
-                   (is_quoted(v.node) && YAML::convert<double>::decode(v.node, x) && std::isfinite(x)
-                        ? "; write it as a plain number, without quotes: " + v.node.Scalar()
-                        : "; write a plain finite number such as 2.5"));
-  return x;
+  const std::optional<double> x = plain_number(v.node);
+  if (!x) fail(v.at, v.path + " must be a number, " + number_expected(v.node));
+  return *x;
 }
 
 // A whole number of any size (up to 2^53); the callers check their ranges on it, so that 1e10 is "out of
@@ -197,6 +192,15 @@ const std::vector<std::pair<std::string, MandibleVariant>> kVariants = {
     {"edentulous", MandibleVariant::kEdentulous},
     {"atrophic", MandibleVariant::kAtrophic}};
 
+// The `units` of a surface or CT geometry: the unit of the file's lengths.
+void read_units(const Map& map, GeometrySpec& g) {
+  if (auto x = map.find("units")) {
+    g.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
+    g.units_given = true;
+  }
+  g.scale_to_mm = unit_to_mm(g.units);
+}
+
 GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
   const Map map(v, {"mandible", "surface", "ct"});
   GeometrySpec g;
@@ -242,25 +246,25 @@ GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
     g.source = GeometrySource::kSurface;
     const Map s(map.get("surface"), {"file", "units"});
     g.file = resolve_file(ctx, s.require("file", "file: jaw.stl"), "surface");
-    if (auto x = s.find("units")) {
-      g.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
-    }
-    g.scale_to_mm = unit_to_mm(g.units);
+    read_units(s, g);
   } else {
     g.source = GeometrySource::kCt;
-    const Map c(map.get("ct"), {"file", "threshold", "series"});
+    const Map c(map.get("ct"), {"file", "threshold", "series", "units"});
     g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume", true);
     g.threshold =
         to_number(c.require("threshold", "threshold: 400 (the bone iso-value, e.g. in Hounsfield units)"));
     if (auto series = c.find("series")) g.dicom_series = to_string(*series);
+    read_units(c, g);
   }
   return g;
 }
 
 LandmarkSpec parse_landmarks(const Source& ctx, const std::optional<Value>& v, const GeometrySpec& geometry) {
   LandmarkSpec l;
-  // A landmark file lies in its surface's frame, so by default it shares the surface's unit.
-  l.scale_to_mm = geometry.source == GeometrySource::kSurface ? geometry.scale_to_mm : 1.0;
+  // A landmark file lies in its bone's frame, so by default it shares the unit written for the surface or
+  // CT volume.
+  if (geometry.source != GeometrySource::kMandible) l.units = geometry.units;
+  l.scale_to_mm = unit_to_mm(l.units);
   if (!v) return l;
   const Map map(*v, {"file", "units", "points"});
   l.where = v->at;
@@ -269,7 +273,8 @@ LandmarkSpec parse_landmarks(const Source& ctx, const std::optional<Value>& v, c
     if (!map.has("file"))
       fail(map.key_at("units"),
            "landmarks.units is given without landmarks.file; add the file or remove units");
-    l.scale_to_mm = unit_to_mm(to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}}));
+    l.units = to_choice<std::string>(*x, {{"mm", "mm"}, {"cm", "cm"}, {"m", "m"}});
+    l.scale_to_mm = unit_to_mm(l.units);
   }
   if (auto x = map.find("points")) {
     if (!x->node.IsNull() && !x->node.IsMap())
@@ -826,9 +831,7 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
   }
   for (const NamedPoint& p : s.landmarks.points) {
     if (known.count(p.name))
-      fail(p.where,
-           "extra point " + quote(p.name) +
-               " has the name of a landmark, so the name would be ambiguous; rename it or use the landmark");
+      fail(p.where, ambiguous_name_text("extra point " + quote(p.name), "a landmark", "the landmark"));
     known[p.name] = p.xyz;
   }
   std::vector<std::string> known_names;
@@ -862,6 +865,20 @@ void resolve_points(Scenario& s, const Landmarks& landmarks) {
                                (m.origin && !m.origin->resolved && m.origin->name == m.name + ".origin") ||
                                !m.max_force_N;
     if (line == landmarks.muscles.end() && !m.pattern_key.empty()) {
+      // A landmark set with one side of the muscle only (a half jaw's file): the pattern key is right, the
+      // side is missing, so suggest the side that exists, with the activation the pattern gives it.
+      const bool left = m.name.rfind("left_", 0) == 0;
+      const std::string other_side = left ? "right" : "left";
+      const std::string other = other_side + "_" + m.pattern_key;
+      if (std::find(muscle_names.begin(), muscle_names.end(), other) != muscle_names.end()) {
+        const auto pattern_other = std::find_if(s.muscles.begin(), s.muscles.end(),
+                                                [&](const Muscle& o) { return o.name == other; });
+        fail(m.where, "activation_pattern key " + quote(m.pattern_key) + " makes " + m.name +
+                          ", but the landmarks have " + other + " only; activate that side alone (" +
+                          m.pattern_key + ": {" + other_side + ": " +
+                          fmt(pattern_other != s.muscles.end() ? pattern_other->activation : m.activation) +
+                          "}), or add " + m.name + " to the landmark file");
+      }
       // A pattern muscle takes everything from the landmarks: name the pattern key and the keys that exist.
       std::vector<std::string> bases;
       for (const std::string& name : muscle_names)

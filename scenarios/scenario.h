@@ -45,8 +45,9 @@ struct GeometrySpec {
   GeometrySource source = GeometrySource::kMandible;
   MandibleParameters mandible;  // kMandible: zero fields mean the variant's defaults (complete_parameters)
   std::string file;             // kSurface, kCt: resolved against the scenario file's folder
-  std::string units = "mm";     // kSurface: the file's length unit
-  double scale_to_mm = 1.0;     // kSurface: unit_to_mm(units)
+  std::string units = "mm";     // kSurface, kCt: the file's length unit
+  double scale_to_mm = 1.0;     // kSurface, kCt: unit_to_mm(units)
+  bool units_given = false;     // kCt: `units` is written; else the unit the volume states, or mm
   double threshold = 0;         // kCt: the iso-value of the bone surface
   std::string dicom_series;     // kCt, a folder holding several DICOM series: the one to read
   SourceLocation where;
@@ -60,7 +61,8 @@ struct NamedPoint {
 
 struct LandmarkSpec {
   std::string file;          // empty: the built-in mandible's own landmarks (or none for other geometry)
-  double scale_to_mm = 1.0;  // the landmark file's unit; defaults to the surface's unit
+  std::string units = "mm";  // the landmark file's unit; defaults to the surface's or CT's unit
+  double scale_to_mm = 1.0;  // unit_to_mm(units)
   std::vector<NamedPoint> points;  // extra named points (mm), usable wherever a point is expected
   SourceLocation where;
 };

@@ -33,10 +33,6 @@ fs::path Source::folder_of(const YAML::Node& node) const {
   throw InputError(where.str() + ": " + message);
 }
 
-bool is_quoted(const YAML::Node& node) {
-  return node.IsScalar() && (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str");
-}
-
 bool decimal_whole_number(const YAML::Node& node, long long* value) {
   if (!node.IsScalar() || is_quoted(node)) return false;
   const std::string& text = node.Scalar();
@@ -50,14 +46,6 @@ bool decimal_whole_number(const YAML::Node& node, long long* value) {
   if (std::abs(x) > 9007199254740992.0) return false;  // 2^53: beyond it a double holds no exact integer
   *value = static_cast<long long>(x);
   return true;
-}
-
-std::string describe(const YAML::Node& node) {
-  if (!node.IsDefined() || node.IsNull()) return "nothing";
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a mapping";
-  if (is_quoted(node)) return "the quoted text \"" + node.Scalar() + "\"";
-  return quote(node.Scalar());
 }
 
 std::string to_string(const Value& v, const std::string& hint) {

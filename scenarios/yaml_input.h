@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/suggestion.h"
+#include "mesher/yaml_scalars.h"
 #include "scenarios/scenario.h"
 
 namespace hexbite::yaml_input {
@@ -54,11 +55,6 @@ struct Value {
   SourceLocation at;
   std::string path;
 };
-
-// Text by the file's word: quoted ("0.5", tag "!") or tagged as a string (!!str 0.5).
-bool is_quoted(const YAML::Node& node);
-// "nothing", "a list", "a mapping", "the quoted text ..." or the scalar quoted: for "found ..." messages.
-std::string describe(const YAML::Node& node);
 
 // A whole number as YAML 1.2 reads it, in decimal: "04000" is 4000 (yaml-cpp's own conversion reads it as
 // octal, 2048, without a word), and "2e3" or "4000.0" are whole numbers too. Hexadecimal and octal

@@ -79,6 +79,10 @@ TEST(Cli, HelpAndVersion) {
   EXPECT_EQ(r.exit_code, 0);
   for (const char* option : {"FILE", "--json", "--units", "-o"})
     EXPECT_NE(r.out.find(option), std::string::npos) << option << " missing in\n" << r.out;
+  // mesh --units scales the --landmarks file too; its help said "of the surface file" only.
+  r = run_hexbite({"mesh", "--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("Length unit of the surface and landmark files"), std::string::npos) << r.out;
 }
 
 TEST(Cli, UsageErrorsExitTwo) {

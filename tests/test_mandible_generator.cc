@@ -325,21 +325,51 @@ TEST(Landmarks, ReadsTheSharedRealJawFile) {
 // by it landed 6.4-6.7 mm off the bone. Each file fits its own bone (median insertion distance 0 mm on the
 // built-in mandible, 0.5 mm on the real jaw) and is flagged on the other (2.9 and 3.2 mm).
 TEST(Landmarks, AFileOfAnotherMandibleIsFlaggedAndItsOwnIsNot) {
+  const std::string kHow = "write units: <unit> in landmarks";
   const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
   const Landmarks jaw_landmarks = read_landmarks(jaw_file);
   const TriSurface jaw = load_closed_surface(test::shared_data("jaw/jaw_smooth.stl"), 1.0);
   const GeneratedMandible& built_in = generated(MandibleVariant::kDentate);
-  EXPECT_EQ(landmark_fit_warning(jaw_landmarks, jaw, jaw_file), "");
-  EXPECT_EQ(landmark_fit_warning(built_in.landmarks, built_in.surface, "m.yaml"), "");
-  const std::string on_jaw = landmark_fit_warning(built_in.landmarks, jaw, "m.yaml");
+  EXPECT_EQ(landmark_fit_warning(jaw_landmarks, jaw, jaw_file, "mm", kHow), "");
+  EXPECT_EQ(landmark_fit_warning(built_in.landmarks, built_in.surface, "m.yaml", "mm", kHow), "");
+  const std::string on_jaw = landmark_fit_warning(built_in.landmarks, jaw, "m.yaml", "mm", kHow);
   EXPECT_NE(on_jaw.find("landmark file m.yaml: its 18 muscle insertions lie a median 2."), std::string::npos)
       << on_jaw;
   EXPECT_NE(on_jaw.find("deep_masseter"), std::string::npos) << on_jaw;
-  const std::string on_built_in = landmark_fit_warning(jaw_landmarks, built_in.surface, jaw_file);
+  const std::string on_built_in = landmark_fit_warning(jaw_landmarks, built_in.surface, jaw_file, "mm", kHow);
   EXPECT_NE(on_built_in.find("anterior_temporalis"), std::string::npos) << on_built_in;
-  // A file in cm read as mm is off by far more.
+  EXPECT_NE(on_jaw.find("; check that the file was written for this surface and in its frame"),
+            std::string::npos)
+      << on_jaw;
+  // A file in cm read as mm is off by far more. The warning said only "check ... its frame and units"; read
+  // in cm it fits, and the warning says so and how to give the unit.
   const Landmarks cm = read_landmarks(jaw_file, 0.1);
-  EXPECT_NE(landmark_fit_warning(cm, jaw, jaw_file), "");
+  const std::string in_cm = landmark_fit_warning(cm, jaw, jaw_file, "mm", kHow);
+  EXPECT_NE(in_cm.find(" will be off; read in cm, they lie a median 0."), std::string::npos) << in_cm;
+  EXPECT_NE(in_cm.find("mm from it: write units: cm in landmarks"), std::string::npos) << in_cm;
+}
+
+// A file with left and right swapped (x negated) fits the nearly symmetric bone as well as the right one and
+// was taken without a word: the bite then lands on the other side. The real jaw's and the built-in
+// mandible's files (which the shipped scenarios use) keep their sides; the mirrored ones are warned of.
+TEST(Landmarks, SwappedSidesAreWarnedOfNamingAPair) {
+  const std::string jaw_file = test::shared_data("jaw/landmarks.yaml");
+  const Landmarks jaw = read_landmarks(jaw_file);
+  EXPECT_EQ(landmark_side_warning(jaw, jaw_file), "");
+  for (MandibleVariant variant :
+       {MandibleVariant::kDentate, MandibleVariant::kEdentulous, MandibleVariant::kAtrophic})
+    EXPECT_EQ(landmark_side_warning(generated(variant).landmarks, "m.yaml"), "");
+  Landmarks mirrored = jaw;
+  for (auto& [name, p] : mirrored.points) p[0] = -p[0];
+  for (MuscleLine& m : mirrored.muscles) m.insertion[0] = -m.insertion[0];
+  const std::string warning = landmark_side_warning(mirrored, "m.yaml");
+  // Named by the pair farthest apart: the condyles, not insertions near the midline.
+  EXPECT_NE(warning.find("landmark file m.yaml: left_condyle_tmj_point lies at x = -51.8 mm, at smaller x "
+                         "than its partner right_condyle_tmj_point (x = 51.8 mm)"),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("(and 10 more of its 11 left/right pairs)"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("swap left_ and right_ in its names"), std::string::npos) << warning;
 }
 
 void expect_landmark_error(const std::string& contents, const std::string& expected_fragment) {
@@ -397,8 +427,11 @@ TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
                         ":3:10: landmark 'b' coordinate is 1e+300, beyond 1e+06 mm in size");
   expect_landmark_error("landmarks:\n  a: [-2000000, 0, 0]\n",
                         ":2:7: landmark 'a' coordinate is -2e+06, beyond");
-  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n", ":2:7: landmark 'a' coordinate is not finite");
-  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n", ":2:13: landmark 'a' coordinate is not finite");
+  expect_landmark_error("landmarks:\n  a: [.nan, 0, 0]\n",
+                        ":2:7: landmark 'a' coordinate must be a number, found '.nan'; write a plain finite "
+                        "number such as 2.5");
+  expect_landmark_error("landmarks:\n  a: [0, 0, -.inf]\n",
+                        ":2:13: landmark 'a' coordinate must be a number, found '-.inf'");
   expect_landmark_error(
       "muscles:\n  - {name: m, max_force_N: 1,\n     insertion: [0, 0, 0],\n     origin: [0, 0, 1e7]}\n",
       ":4:21: muscle 'm' origin coordinate is 1e+07, beyond 1e+06 mm in size");
@@ -422,6 +455,36 @@ TEST(Landmarks, CoordinatesAndForcesBeyondTheScenariosBoundsAreRefused) {
                    "landmarks:\n  a: [1e6, -1e6, 0]\nmuscles:\n  - {name: m, max_force_N: 10000, "
                    "insertion: [0, 0, 0], origin: [0, 0, 1]}\n");
   EXPECT_EQ(read_landmarks(path).muscles.at(0).max_force_N, 10000.0);
+}
+
+// Quoted numbers were read as numbers, where a scenario refuses them ("a quoted "0.5" is text"): the same
+// rule and message now.
+TEST(Landmarks, QuotedNumbersAreRefusedAsInAScenario) {
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: \"190.4\", insertion: [0, 0, 0], origin: [0, 0, 1]}\n",
+      ":2:28: muscle 'm' max_force_N must be a number, found the quoted text \"190.4\"; write it as a plain "
+      "number, without quotes: 190.4");
+  expect_landmark_error("landmarks:\n  a: [\"47.12\", 0, 0]\n",
+                        ":2:7: landmark 'a' coordinate must be a number, found the quoted text \"47.12\"");
+}
+
+// A landmark named like a muscle's insertion or origin was shadowed by the muscle's point, without a word
+// (a scenario refuses such an extra point as ambiguous).
+TEST(Landmarks, PointNamedLikeAMusclesInsertionIsRefusedAsAmbiguous) {
+  expect_landmark_error(
+      "landmarks:\n  m.insertion: [1, 2, 3]\nmuscles:\n  - {name: m, max_force_N: 1, insertion: [0, 0, 0], "
+      "origin: [0, 0, 1]}\n",
+      ":2:3: landmark 'm.insertion' has the name of the insertion of muscle 'm' (line 4), so the name would "
+      "be "
+      "ambiguous; rename it or use the muscle's insertion");
+  expect_landmark_error(
+      "muscles:\n  - {name: m, max_force_N: 1, insertion: [0, 0, 0], origin: [0, 0, 1]}\nlandmarks:\n  "
+      "m.origin: [1, 2, 3]\n",
+      ":4:3: landmark 'm.origin' has the name of the origin of muscle 'm' (line 2)");
+  // A dotted name of no muscle of the file is a name like any other.
+  const std::string path = test::temp_dir() + "/dotted.yaml";
+  test::write_file(path, "landmarks:\n  implant.insertion: [1, 2, 3]\n");
+  EXPECT_TRUE(read_landmarks(path).find("implant.insertion").has_value());
 }
 
 // Every option within its range, but together a short, wide ramus at the largest gonial angle made a bone

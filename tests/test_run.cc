@@ -24,6 +24,7 @@
 #include "mesher/hex_mesh.h"
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_point_location.h"
+#include "mesher/mandible_generator.h"
 #include "postprocess/report_format.h"
 #include "tests/test_util.h"
 
@@ -735,18 +736,14 @@ std::string box_obj(double scale) {
   return text;
 }
 
-// A surface in the wrong unit: a mandible in cm read as mm is about 12 mm across, which the warning for
-// metres and micrometres (under 0.5 mm, over 3000 mm) let pass, and the run solved it with exit 0 and
-// stresses a hundred times too large (the real jaw in cm: von Mises max 1339 MPa). One in mm read as m was
-// warned of as micrometres. The run warns, naming the unit that gives a mandible-sized bone.
-TEST(RunScenario, SurfaceInAnImplausibleUnitIsWarnedOfWithTheUnitThatFits) {
-  const std::string dir = test::temp_dir();
-  const auto run_box = [&](const std::string& name, double scale, const std::string& units, double at) {
-    test::write_file(dir + "/" + name + ".obj", box_obj(scale));
-    char text[800];
-    std::snprintf(text, sizeof text, R"(name: %s
+// Runs a scenario that pulls a box along z, 10 x 4 x 3 times `at` mm in the frame of its `geometry` (one
+// line, e.g. "surface: {file: box.obj}"), held at the end x = 0: small enough to mesh and solve in a moment.
+test::CommandResult run_box(const std::string& dir, const std::string& name, const std::string& geometry,
+                            double at) {
+  char text[800];
+  std::snprintf(text, sizeof text, R"(name: %s
 geometry:
-  surface: {file: %s.obj%s}
+  %s
 mesh: {target_hexes: 300, validation_levels: 0}
 muscles:
   - {name: pull, activation: 1, insertion: [%g, %g, %g], radius_mm: %g, direction: [0, 0, 1], max_force_N: 10}
@@ -754,13 +751,25 @@ supports:
   - {name: base, at: [0, %g, %g], radius_mm: %g}
 outputs: {bite_force: false}
 )",
-                  name.c_str(), name.c_str(), units.empty() ? "" : (", units: " + units).c_str(), 10 * at,
-                  2 * at, 1.5 * at, std::min(2 * at, 50.0), 2 * at, 1.5 * at, std::min(2 * at, 50.0));
-    test::write_file(dir + "/" + name + ".yaml", text);
-    return test::run_hexbite({"-q", "run", dir + "/" + name + ".yaml", "-o", dir + "/" + name});
+                name.c_str(), geometry.c_str(), 10 * at, 2 * at, 1.5 * at, std::min(2 * at, 50.0), 2 * at,
+                1.5 * at, std::min(2 * at, 50.0));
+  test::write_file(dir + "/" + name + ".yaml", text);
+  return test::run_hexbite({"-q", "run", dir + "/" + name + ".yaml", "-o", dir + "/" + name});
+}
+
+// A surface in the wrong unit: a mandible in cm read as mm is about 12 mm across, which the warning for
+// metres and micrometres (under 0.5 mm, over 3000 mm) let pass, and the run solved it with exit 0 and
+// stresses a hundred times too large (the real jaw in cm: von Mises max 1339 MPa). One in mm read as m was
+// warned of as micrometres. The run warns, naming the unit that gives a mandible-sized bone.
+TEST(RunScenario, SurfaceInAnImplausibleUnitIsWarnedOfWithTheUnitThatFits) {
+  const std::string dir = test::temp_dir();
+  const auto run_box_obj = [&](const std::string& name, double scale, const std::string& units, double at) {
+    test::write_file(dir + "/" + name + ".obj", box_obj(scale));
+    return run_box(dir, name,
+                   "surface: {file: " + name + ".obj" + (units.empty() ? "" : ", units: " + units) + "}", at);
   };
   // In cm, read as mm: 10 mm across.
-  const test::CommandResult cm = run_box("in_cm", 1.0, "", 1.0);
+  const test::CommandResult cm = run_box_obj("in_cm", 1.0, "", 1.0);
   EXPECT_EQ(cm.exit_code, 0) << cm.err;  // a warning, not an error: the grid method meshes any size
   EXPECT_NE(cm.err.find("in_cm.yaml:3:3: "), std::string::npos) << cm.err;
   EXPECT_NE(cm.err.find("the surface is 10 mm across (the largest side of its bounding box) with its "
@@ -769,7 +778,7 @@ outputs: {bite_force: false}
             std::string::npos)
       << cm.err;
   // In mm, read as m: 100,000 mm across.
-  const test::CommandResult m = run_box("in_mm", 10.0, "m", 10000.0);
+  const test::CommandResult m = run_box_obj("in_mm", 10.0, "m", 10000.0);
   EXPECT_NE(m.err.find("the surface is 1e+05 mm across"), std::string::npos) << m.err;
   EXPECT_NE(m.err.find("read as m; a mandible is about 100 mm. If the file's coordinates are in mm (100 mm "
                        "across), write units: mm"),
@@ -777,9 +786,38 @@ outputs: {bite_force: false}
       << m.err;
   EXPECT_EQ(m.err.find("micrometres"), std::string::npos) << m.err;
   // In mm, read as mm: no warning.
-  const test::CommandResult mm = run_box("right", 10.0, "", 10.0);
+  const test::CommandResult mm = run_box_obj("right", 10.0, "", 10.0);
   EXPECT_EQ(mm.exit_code, 0) << mm.err;
   EXPECT_EQ(mm.err.find("warning"), std::string::npos) << mm.err;
+}
+
+// A CT volume in the wrong unit: the generator's CT with its spacing and offset in cm ran with exit 0 and
+// stresses about a hundred times too large, without the warning a surface file gets. The volume here is a
+// box of 10 x 4 x 3 voxels of 1 cm, a MetaImage, which states no unit: read as mm it is 10 mm across and
+// warned of, naming units: cm in geometry.ct, which then reads it as 100 mm without a word.
+TEST(RunScenario, CtVolumeInAnImplausibleUnitIsWarnedOfAndUnitsReadsIt) {
+  const std::string dir = test::temp_dir();
+  VoxelVolume box;
+  box.dims = {12, 6, 5};
+  box.values.assign(12 * 6 * 5, 0.0f);
+  for (int k = 1; k <= 3; ++k)
+    for (int j = 1; j <= 4; ++j)
+      for (int i = 1; i <= 10; ++i) box.values[i + 12 * (j + 6 * k)] = 1000.0f;
+  box.origin = {-0.5, -0.5, -0.5};  // the iso-surface at 500 is then the box x 0-10, y 0-4, z 0-3
+  write_volume(dir + "/box.mha", box);
+  const test::CommandResult as_mm = run_box(dir, "as_mm", "ct: {file: box.mha, threshold: 500}", 1.0);
+  EXPECT_EQ(as_mm.exit_code, 0) << as_mm.err;  // a warning, as for a surface
+  EXPECT_NE(as_mm.err.find("as_mm.yaml:3:3: " + dir +
+                           "/box.mha: the surface is 10 mm across (the largest "
+                           "side of its bounding box) with its coordinates read as mm; a mandible is about "
+                           "100 mm. If the file's coordinates are in cm (100 mm across), write units: cm in "
+                           "geometry.ct (a landmarks.file without units of its own follows it)"),
+            std::string::npos)
+      << as_mm.err;
+  const test::CommandResult in_cm =
+      run_box(dir, "in_cm", "ct: {file: box.mha, threshold: 500, units: cm}", 10.0);
+  EXPECT_EQ(in_cm.exit_code, 0) << in_cm.err;
+  EXPECT_EQ(in_cm.err.find("warning"), std::string::npos) << in_cm.err;
 }
 
 // Support names that differ only in case or punctuation give one CalculiX set name: the export failed

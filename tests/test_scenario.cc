@@ -298,6 +298,24 @@ TEST(ScenarioErrors, ActivationPatternMistakesAreNamedAsThePatterns) {
                   9, "activation_pattern.superficial_masseter gives no side");
 }
 
+// A landmark set with the left muscle only: the pattern's key was called "no muscle of the landmarks" and
+// the closest pattern key suggested was the same key. The missing side is named, and the side that exists
+// suggested with its activation.
+TEST(ScenarioErrors, ActivationPatternOfAMuscleWithOneSideInTheLandmarksNamesTheSide) {
+  Landmarks landmarks = generator_landmarks();
+  landmarks.muscles.erase(std::remove_if(landmarks.muscles.begin(), landmarks.muscles.end(),
+                                         [](const MuscleLine& m) { return m.name == "right_deep_masseter"; }),
+                          landmarks.muscles.end());
+  Scenario s = load_scenario(write_scenario(kValid + "activation_pattern:\n  deep_masseter: 0.5\n"));
+  const std::string err = test::message_of<InputError>([&] { resolve_points(s, landmarks); });
+  EXPECT_NE(err.find("activation_pattern key 'deep_masseter' makes right_deep_masseter, but the landmarks "
+                     "have left_deep_masseter only; activate that side alone (deep_masseter: {left: 0.5}), "
+                     "or add right_deep_masseter to the landmark file"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("closest pattern keys"), std::string::npos) << err;
+}
+
 // A landmark file may give a muscle 0 N; an active muscle of 0 N loads nothing (alone, the run solved a
 // zero load and reported a bite force of 0 N with exit 0).
 TEST(ScenarioErrors, ActiveMuscleWithoutForceInTheLandmarks) {
