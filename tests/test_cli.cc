@@ -427,7 +427,7 @@ TEST(Cli, RunAndStudyStartUnderAFileSizeLimitAndNameAnUnusableTmpdir) {
   const std::string dir = temp_dir();
   test::CommandResult r = run_hexbite({"run", dir + "/none.yaml", "-o", dir + "/out"}, limited);
   EXPECT_EQ(r.exit_code, 2) << r.err;
-  EXPECT_NE(r.err.find("cannot read scenario file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scenario file '" + dir + "/none.yaml' does not exist"), std::string::npos) << r.err;
   r = run_hexbite({"run", dir + "/none.yaml", "-o", dir + "/out"}, {"env", "TMPDIR=/proc"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(r.err,
