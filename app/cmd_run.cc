@@ -91,7 +91,7 @@ void add_run_command(CLI::App& app) {
          "--levels", o->levels,
          "Validation levels (each refines the mesh 8-way and solves again); overrides the scenario's "
          "mesh.validation_levels")
-      ->transform(count_in_range(0, 3));
+      ->transform(count_in_range(0, kMaxValidationLevels));
   cmd->add_flag("--json", o->json, "Print results.json instead of the summary table");
   cmd->callback([o] { run_run(*o); });
 }

@@ -203,7 +203,7 @@ void add_study_command(CLI::App& app) {
   cmd->add_option("--levels", o->levels,
                   "Validation levels of every variant (each refines the mesh 8-way and solves again); "
                   "overrides the scenarios' mesh.validation_levels")
-      ->transform(count_in_range(0, 3));
+      ->transform(count_in_range(0, kMaxValidationLevels));
   // Asked for by users who wanted every variant's CalculiX deck: `--export inp` was "not expected".
   add_export_option(*cmd, o->export_formats);
   cmd->add_flag("--json", o->json, "Print study.json instead of the table");

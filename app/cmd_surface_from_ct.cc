@@ -20,6 +20,7 @@ namespace {
 
 struct FromCtArgs {
   std::string volume, output, series;
+  std::string units;  // empty: the unit the file states, or mm
   double threshold = 0;
 };
 
@@ -31,10 +32,13 @@ void run_from_ct(const FromCtArgs& args) {
     throw InputError("cannot write '" + args.output + "': directory '" + dir.string() +
                      "' does not exist; create it first");
 
+  if (!args.units.empty()) unit_to_mm(args.units);  // an unknown unit is refused before the reading
+
   const auto start = std::chrono::steady_clock::now();
   Progress progress("extract surface");
   VolumeInfo source;
-  const VoxelVolume volume = read_volume(args.volume, &source, args.series);
+  VoxelVolume volume = read_volume(args.volume, &source, args.series);
+  if (!args.units.empty()) rescale_volume_units(volume, source.length_unit, args.units);
   CtExtraction dropped;
   TriSurface surface;
   try {
@@ -67,10 +71,16 @@ void run_from_ct(const FromCtArgs& args) {
                 surface.triangles.size(), surface.vertices.size(), six_volume / 6000.0, seconds);
   info(buf);
   info("wrote " + args.output);
-  // A volume whose spacing is in metres gives a bone a thousand times too small.
+  // A volume whose spacing is in metres gives a bone a thousand times too small. Its lengths were read in
+  // --units, else in the unit the file states (a NIfTI header, DICOM's mm), else (MetaImage) in mm.
+  const std::string read_as = !args.units.empty()          ? args.units
+                              : source.length_unit.empty() ? "mm"
+                                                           : source.length_unit;
   const std::string size_warning = implausible_size_warning(
-      largest_extent(surface), "mm",
-      "give the volume its spacing in millimetres (MetaImage has no unit of its own)");
+      largest_extent(surface), read_as,
+      "give --units <unit>" + (args.units.empty() && !source.length_unit.empty()
+                                   ? " (it overrides the unit the file states, " + source.length_unit + ")"
+                                   : std::string()));
   if (!size_warning.empty())
     std::fprintf(stderr, "hexbite: warning: '%s': %s.\n", args.volume.c_str(), size_warning.c_str());
   // Only the largest piece is kept; what else the threshold found must not vanish without a word
@@ -93,6 +103,10 @@ void add_surface_from_ct_command(CLI::App& surface) {
       ->required()
       ->check(number_in_range(-std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
                               "that is finite, in the volume's units (e.g. 620 Hounsfield units)"));
+  cmd->add_option(
+      "--units", args->units,
+      "Length unit of the volume's spacing and origin: mm, cm or m (the surface is written in mm); "
+      "overrides the unit a NIfTI or DICOM file states; a MetaImage states none and is read as mm");
   cmd->add_option("--series", args->series,
                   "In a folder holding several DICOM series, the one to read: its Series Number, Series "
                   "Description or Series Instance UID");

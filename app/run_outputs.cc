@@ -440,10 +440,11 @@ bool is_earlier_run_output(const std::string& dir, const std::string& name) {
 }
 
 bool is_run_output_name(const std::string& filename) {
-  // Levels 1 to 3 only (run --levels, mesh.validation_levels): a solution_level4.vtu was never written by a
-  // run, so it is the user's and stays.
-  static const std::regex kOutputName(
-      R"((results\.json|mesh\.vtu|model(_mesh)?\.inp|solution(_level[1-3])?(\.pvtu|(_[0-9]+)?\.vtu)))");
+  // Levels 1 to kMaxValidationLevels only: a solution_level4.vtu was never written by a run, so it is the
+  // user's and stays.
+  static const std::regex kOutputName(R"((results\.json|mesh\.vtu|model(_mesh)?\.inp|solution(_level[1-)" +
+                                      std::to_string(kMaxValidationLevels) +
+                                      R"(])?(\.pvtu|(_[0-9]+)?\.vtu)))");
   return std::regex_match(filename, kOutputName);
 }
 

@@ -61,17 +61,6 @@ struct Geometry {
   std::string volume_unit;  // a CT volume: the unit its file states (VolumeInfo::length_unit)
 };
 
-// A CT volume's lengths as `units` (mm, cm, m) read them, where the reader took them in `stated` (the unit
-// the file states, or mm when it states none), so that `geometry.ct.units` holds for any file.
-void rescale_to_units(VoxelVolume& volume, const std::string& stated, const std::string& units) {
-  const double factor = unit_to_mm(units) / stated_unit_to_mm(stated);
-  for (int a = 0; a < 3; ++a) {
-    volume.origin[a] *= factor;
-    volume.axis_spacing[a] *= factor;
-  }
-  volume.spacing *= factor;
-}
-
 // A warning on standard error, from rank 0 only (every rank builds the same geometry).
 void warn(const std::string& line) {
   if (MpiSession::rank() == 0) std::cerr << "hexbite: warning: " << line << ".\n";
@@ -104,7 +93,7 @@ Geometry build_geometry(const Scenario& s) {
       try {
         VoxelVolume volume = read_volume(s.geometry.file, &source, s.geometry.dicom_series);
         g.volume_unit = source.length_unit;
-        if (s.geometry.units_given) rescale_to_units(volume, source.length_unit, s.geometry.units);
+        if (s.geometry.units_given) rescale_volume_units(volume, source.length_unit, s.geometry.units);
         g.surface = surface_from_volume(volume, s.geometry.threshold, &dropped);
       } catch (const InputError& e) {
         const std::string what = e.what();

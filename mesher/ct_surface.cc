@@ -829,4 +829,13 @@ std::vector<std::string> describe_dropped(const CtExtraction& dropped, double th
   return out;
 }
 
+void rescale_volume_units(VoxelVolume& volume, const std::string& stated_unit, const std::string& unit) {
+  const double factor = unit_to_mm(unit) / stated_unit_to_mm(stated_unit);
+  for (int a = 0; a < 3; ++a) {
+    volume.origin[a] *= factor;
+    volume.axis_spacing[a] *= factor;
+  }
+  volume.spacing *= factor;
+}
+
 }  // namespace hexbite

@@ -26,6 +26,11 @@ struct VolumeInfo {
 VoxelVolume read_volume(const std::string& path, VolumeInfo* info = nullptr,
                         const std::string& dicom_series = {});
 
+// Rescales a volume whose reader took its lengths in `stated_unit` (VolumeInfo::length_unit: the unit the
+// file states, or "" for none, read as mm) to a reading in `unit` (mm, cm or m), for a file that states no
+// unit or a wrong one (a scenario's geometry.ct units, surface from-ct --units).
+void rescale_volume_units(VoxelVolume& volume, const std::string& stated_unit, const std::string& unit);
+
 // What the extraction left out: the iso-surface's other connected pieces, told apart by the sign
 // of their enclosed volume (marching cubes orients every piece the same way relative to the
 // values, so a cavity's wall encloses a volume of the opposite sign to a body's).

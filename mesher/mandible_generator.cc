@@ -26,6 +26,7 @@
 #include <map>
 
 #include "common/error.h"
+#include "common/number_format.h"
 #include "mesher/ct_surface.h"
 
 namespace hexbite {
@@ -431,9 +432,10 @@ MandibleParameters defaults_for(MandibleVariant v) {
 
 void check_range(const char* name, double value, double lo, double hi) {
   if (!std::isfinite(value) || value < lo || value > hi) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "--%s %g is outside the accepted range %g to %g", name, value, lo, hi);
-    throw InputError(buf);
+    // The value with its own digits: "%g" would print 150.0000001 as the limit 150.
+    throw InputError(std::string("--") + name + " " + format_significant(value) +
+                     " is outside the accepted range " + format_significant(lo) + " to " +
+                     format_significant(hi));
   }
 }
 

@@ -313,10 +313,10 @@ MeshSettings parse_mesh(const Value& v) {
   if (auto x = map.find("validation_levels")) {
     const long long n = to_whole(*x);
     m.validation_levels_at = x->at;
-    // Each level multiplies the mesh by 8: four levels of the default mesh would be ten million hexes.
-    if (n < 0 || n > 3)
-      fail(x->at, "mesh.validation_levels is " + std::to_string(n) +
-                      " but must be 0 (none), 1, 2 or 3; each level refines the mesh 8-way and solves again");
+    if (n < 0 || n > kMaxValidationLevels)
+      fail(x->at, "mesh.validation_levels is " + std::to_string(n) + " but must be from 0 (none) to " +
+                      std::to_string(kMaxValidationLevels) +
+                      "; each level refines the mesh 8-way and solves again");
     m.validation_levels = static_cast<int>(n);
   }
   if (auto x = map.find("refine_at_bite")) {

@@ -70,6 +70,10 @@ struct LandmarkSpec {
 enum class MeshMethod { kGrid, kSheets };
 enum class MeshCore { kGrid, kSwept, kAuto };
 
+// The most validation levels a run takes (scenario mesh.validation_levels, run and study --levels). Each
+// level multiplies the mesh by 8: four levels of the default mesh would be ten million hexes.
+constexpr int kMaxValidationLevels = 3;
+
 struct MeshSettings {
   MeshMethod method = MeshMethod::kGrid;
   int target_hexes = 2500;

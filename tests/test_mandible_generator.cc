@@ -273,6 +273,14 @@ TEST(MandibleGenerator, RejectsParametersOutsideTheirRanges) {
   p = {};
   p.gonial_angle_deg = 200;
   EXPECT_THROW(complete_parameters(p), InputError);
+  // Just past the limit: the message quotes the value with its own digits ("%g" printed the limit, 140).
+  p.gonial_angle_deg = 140.0000001;
+  try {
+    complete_parameters(p);
+    ADD_FAILURE() << "a gonial angle past its range was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "--gonial-angle 140.0000001 is outside the accepted range 105 to 140");
+  }
   p = {};
   p.voxel_mm = -1;
   EXPECT_THROW(generate_mandible(p), InputError);
@@ -853,6 +861,51 @@ TEST(Cli, SurfaceFromCtWarnsAboutWhatItDrops) {
       << r.err;
   EXPECT_NE(r.err.find("dropped 1 separate piece(s)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("filled 1 enclosed cavity"), std::string::npos) << r.err;
+}
+
+// `--units` overrides the unit a volume states (or, for a MetaImage, the mm it is read in); the surface is
+// written in mm. A NIfTI whose header says metres where its numbers are millimetres gives a bone 1000 times
+// too large: the warning names the unit to give and that it overrides the file's. An unknown unit is refused
+// before anything is read or written.
+TEST(Cli, SurfaceFromCtTakesAUnitThatOverridesTheVolumes) {
+  const std::string dir = test::temp_dir();
+  write_volume(dir + "/jaw.mha", generated(MandibleVariant::kAtrophic).ct);
+  write_volume(dir + "/jaw.nii", generated(MandibleVariant::kAtrophic).ct);
+  std::string in_metres = read_bytes(dir + "/jaw.nii");
+  ASSERT_GT(in_metres.size(), 348u);
+  in_metres[123] = static_cast<char>((in_metres[123] & ~0x07) | 1);  // xyzt_units: metre
+  write_bytes(dir + "/metres.nii", in_metres);
+  auto extent = [&](const std::vector<std::string>& args) {
+    std::vector<std::string> command = {"-q", "surface", "from-ct"};
+    command.insert(command.end(), args.begin(), args.end());
+    command.insert(command.end(), {"--threshold", "620", "-o", dir + "/out.stl"});
+    const auto r = test::run_hexbite(command);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    return largest_extent(read_surface(dir + "/out.stl"));
+  };
+  const double mm = extent({dir + "/jaw.mha"});
+  EXPECT_GT(mm, 50.0);
+  EXPECT_NEAR(extent({dir + "/jaw.mha", "--units", "cm"}), 10 * mm, 1e-6 * mm);
+  EXPECT_NEAR(extent({dir + "/jaw.nii", "--units", "cm"}), 10 * mm, 1e-6 * mm);
+  EXPECT_NEAR(extent({dir + "/metres.nii", "--units", "mm"}), mm, 1e-6 * mm);
+
+  auto r = test::run_hexbite(
+      {"-q", "surface", "from-ct", dir + "/metres.nii", "--threshold", "620", "-o", dir + "/big.stl"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: '" + dir + "/metres.nii': the surface is "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("with its coordinates read as m; a mandible is about 100 mm"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("give --units mm (it overrides the unit the file states, m)"), std::string::npos)
+      << r.err;
+
+  fs::remove(dir + "/out.stl");
+  r = test::run_hexbite({"surface", "from-ct", dir + "/jaw.mha", "--units", "inch", "--threshold", "620",
+                         "-o", dir + "/out.stl"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown length unit 'inch': use one of mm, cm, m"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out.stl"));
 }
 
 TEST(Cli, GenerateThenSurfaceFromCtReproducesTheVolume) {

@@ -451,7 +451,7 @@ TEST(ScenarioErrors, IllTypedFields) {
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {target_hexes: 1e10}\n"), 11,
                   "mesh.target_hexes is 10000000000 but must be from 8 to 5000000");
   EXPECT_ERROR_AT(error_of(kValid + "mesh: {validation_levels: 2147483648}\n"), 11,
-                  "mesh.validation_levels is 2147483648 but must be 0 (none), 1, 2 or 3");
+                  "mesh.validation_levels is 2147483648 but must be from 0 (none) to 3");
   EXPECT_ERROR_AT(error_of(kValid + "solver: {max_iterations: 1e12}\n"), 11,
                   "solver.max_iterations is 1000000000000 but must be from 1 to 2147483647");
   EXPECT_ERROR_AT(error_of(kValid + "description: [a, b]\n"), 11,
