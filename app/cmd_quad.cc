@@ -181,10 +181,11 @@ struct QuadFromMeshOptions {
 // The boundary quads of a hex mesh (outward, on the mesh's own boundary vertices), e.g. to mesh the same
 // boundary again by cycle elimination (hexbite mesh --method sheets --quad-surface), which keeps it exactly.
 void run_quad_from_mesh(const QuadFromMeshOptions& o) {
-  const HexMesh mesh = read_hex_mesh(o.mesh);
+  const HexMeshInput input = load_hex_mesh_input(o.mesh);
+  const HexMesh& mesh = input.mesh;
   // An inverted hex's faces point inward, so its boundary quads would not be the outward surface claimed
   // here (a mirrored mesh gives a wholly inward one): refused as bad input, as hexbite refine does.
-  require_no_inverted_hexes(mesh, o.mesh,
+  require_no_inverted_hexes(input, o.mesh,
                             "whose faces point inward, so its boundary is not an outward quad surface");
   const HexBoundary boundary = extract_boundary(mesh);
   write_quad_obj(o.output, boundary.surface);

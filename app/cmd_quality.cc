@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "app/mesh_inputs.h"
 #include "app/option_checks.h"
 #include "common/json_text.h"
 #include "common/progress.h"
@@ -60,7 +62,9 @@ std::string degree_line(const std::vector<int>& counts) {
   return first ? std::string("none") : out.str();
 }
 
-std::string quality_table(const std::string& path, const QualitySummary& s) {
+// `label(h)`, when given, follows hex h's number (the Gmsh element tag of a .msh input's hex).
+std::string quality_table(const std::string& path, const QualitySummary& s,
+                          const std::function<std::string(int)>& label) {
   std::ostringstream out;
   out << "Quality of " << path << ": " << s.hexes << " hexes, " << s.nodes << " nodes\n\n";
   char header[128];
@@ -76,7 +80,8 @@ std::string quality_table(const std::string& path, const QualitySummary& s) {
         << " hexes that are not inverted\n";
     out << "  inverted hexes (0-based):";
     const std::size_t shown = std::min<std::size_t>(s.inverted_hexes.size(), 20);
-    for (std::size_t i = 0; i < shown; ++i) out << ' ' << s.inverted_hexes[i];
+    for (std::size_t i = 0; i < shown; ++i)
+      out << ' ' << s.inverted_hexes[i] << (label ? label(s.inverted_hexes[i]) : std::string());
     if (shown < s.inverted_hexes.size()) out << " ... (" << s.inverted_hexes.size() - shown << " more)";
     out << '\n';
   }
@@ -88,17 +93,22 @@ std::string quality_table(const std::string& path, const QualitySummary& s) {
   return out.str();
 }
 
-// The worst hexes as a small table after the report.
-std::string worst_table(const std::vector<WorstHex>& worst) {
+// The worst hexes as a small table after the report, with the Gmsh element tags of a .msh input's hexes
+// (`element_tags`; none for a .vtu).
+std::string worst_table(const std::vector<WorstHex>& worst, const std::vector<long>& element_tags) {
   std::ostringstream out;
   out << "\nworst " << worst.size() << (worst.size() == 1 ? " hex" : " hexes")
       << " (lowest scaled Jacobian first; ties: larger condition number first):\n";
   char line[192];
-  std::snprintf(line, sizeof line, "%10s%18s%18s   %s\n", "hex", "scaled Jacobian", "condition",
+  // A .msh input's hexes get a column with their Gmsh element tags after the 0-based index.
+  std::snprintf(line, sizeof line, "%10s%s%18s%18s   %s\n", "hex",
+                element_tags.empty() ? "" : "    Gmsh element", "scaled Jacobian", "condition",
                 "centroid (mm)");
   out << line;
   for (const WorstHex& w : worst) {
-    std::snprintf(line, sizeof line, "%10d%18s%18s   (%.2f, %.2f, %.2f)\n", w.hex,
+    char tag[32] = "";
+    if (!element_tags.empty()) std::snprintf(tag, sizeof tag, "%16ld", element_tags[w.hex]);
+    std::snprintf(line, sizeof line, "%10d%s%18s%18s   (%.2f, %.2f, %.2f)\n", w.hex, tag,
                   cell(w.scaled_jacobian).c_str(), cell(w.condition).c_str(), w.centroid[0], w.centroid[1],
                   w.centroid[2]);
     out << line;
@@ -107,13 +117,15 @@ std::string worst_table(const std::vector<WorstHex>& worst) {
   return out.str();
 }
 
-nlohmann::json worst_json(const std::vector<WorstHex>& worst) {
+nlohmann::json worst_json(const std::vector<WorstHex>& worst, const std::vector<long>& element_tags) {
   nlohmann::json list = nlohmann::json::array();
-  for (const WorstHex& w : worst)
+  for (const WorstHex& w : worst) {
     list.push_back({{"hex", w.hex},
                     {"scaled_jacobian", w.scaled_jacobian},
                     {"condition", w.condition},
                     {"centroid", {w.centroid[0], w.centroid[1], w.centroid[2]}}});
+    if (!element_tags.empty()) list.back()["gmsh_element"] = element_tags[w.hex];
+  }
   return list;
 }
 
@@ -136,18 +148,19 @@ void add_quality_command(CLI::App& app) {
   cmd->callback([options, worst_option] {
     const bool list_worst = worst_option->count() > 0;
     // Gmsh meshes are read too, so that peer meshers can be measured with exactly the same code.
-    const HexMesh mesh = read_hex_mesh(options->mesh);
+    const HexMeshInput input = load_hex_mesh_input(options->mesh);
+    const HexMesh& mesh = input.mesh;
     const HexQualityField field = compute_hex_quality(mesh);
     const QualitySummary summary = summarize_quality(mesh, field);
     const std::vector<WorstHex> worst = worst_hexes(mesh, field, static_cast<std::size_t>(options->worst));
     if (options->json) {
       // The volume lets benchmarks compare a mesh with its surface (and peers' meshes with ours).
       nlohmann::json j = quality_to_json(summary, hex_mesh_volume(mesh));
-      if (list_worst) j["worst"] = worst_json(worst);
+      if (list_worst) j["worst"] = worst_json(worst, input.element_tags);
       std::cout << json_text(j) << '\n';
     } else if (!is_quiet()) {  // --quiet: like every other report, only the exit code tells
-      std::cout << quality_table(options->mesh, summary);
-      if (!worst.empty()) std::cout << worst_table(worst);
+      std::cout << quality_table(options->mesh, summary, input.hex_label());
+      if (!worst.empty()) std::cout << worst_table(worst, input.element_tags);
     }
   });
 }

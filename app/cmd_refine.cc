@@ -184,14 +184,22 @@ void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surf
        << boundary.boundary_vertices.size() << " boundary nodes are farther than half a mean boundary edge ("
        << limit << " mm) from it, up to " << farthest << " mm (node " << worst << " at ("
        << coarse.vertices[worst][0] << ", " << coarse.vertices[worst][1] << ", " << coarse.vertices[worst][2]
-       << ") mm); give the surface the mesh was made from, in its units (--units, now " << o.units << ")";
+       << ") mm)";
+  // A mesh of no bone's size is the one off in scale: --units cannot fix it, as it sets the surface's unit.
+  if (!mesh_size_warning(largest_extent(coarse.vertices)).empty())
+    text << "; the mesh is " << largest_extent(coarse.vertices)
+         << " mm across, no bone's size: hex mesh files are read in mm, so scale the mesh to millimetres "
+            "where it was made (--units sets the unit of the surface only)";
+  else
+    text << "; give the surface the mesh was made from, in its units (--units, now " << o.units << ")";
   throw InputError(text.str());
 }
 
 void run_refine(const RefineCliOptions& o) {
   if (o.fit_volume && o.surface.empty())
     throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
-  const HexMesh coarse = read_hex_mesh(o.mesh);
+  const HexMeshInput input = load_hex_mesh_input(o.mesh);
+  const HexMesh& coarse = input.mesh;
   const long long refined = static_cast<long long>(coarse.hexes.size()) << (3 * o.levels);
   if (refined > kMaxRefinedHexes)
     throw InputError("--levels " + std::to_string(o.levels) + " would turn the " +
@@ -199,7 +207,7 @@ void run_refine(const RefineCliOptions& o) {
                      std::to_string(refined) + " hexes, more than " + std::to_string(kMaxRefinedHexes) +
                      "; use fewer levels");
   // Every child of an inverted hex is inverted too, so refining an inverted mesh can only fail at the end.
-  require_no_inverted_hexes(coarse, o.mesh, "which refinement cannot repair");
+  require_no_inverted_hexes(input, o.mesh, "which refinement cannot repair");
   std::unique_ptr<SurfaceProjector> projector;
   if (!o.surface.empty()) {
     projector = std::make_unique<SurfaceProjector>(load_surface_input(o.surface, o.units));
@@ -219,11 +227,18 @@ void run_refine(const RefineCliOptions& o) {
   else if (!is_quiet())
     std::cout << report_text(o, report);
   if (!valid) {
-    throw RunError(
-        std::to_string(report.after.inverted) + " hexes of the refined mesh are inverted: " +
-        hex_list_text(fine, report.after.inverted_hexes, 20,
-                      [&o](int h) { return " (in input hex " + std::to_string(h >> (3 * o.levels)) + ")"; }) +
-        "; no mesh written");
+    throw RunError(std::to_string(report.after.inverted) + " hexes of the refined mesh are inverted: " +
+                   hex_list_text(fine, report.after.inverted_hexes, 20,
+                                 [&](int h) {
+                                   const int parent = h >> (3 * o.levels);
+                                   return " (in input hex " + std::to_string(parent) +
+                                          (input.element_tags.empty()
+                                               ? std::string()
+                                               : ", Gmsh element " +
+                                                     std::to_string(input.element_tags[parent])) +
+                                          ")";
+                                 }) +
+                   "; no mesh written");
   }
   if (!o.json) info("wrote " + o.output);
 }

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -15,11 +16,14 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/mesh_inputs.h"
 #include "app/option_checks.h"
 #include "common/error.h"
 #include "common/json_text.h"
+#include "common/paths.h"
 #include "common/progress.h"
 #include "mesher/hex_mesh_io.h"
+#include "mesher/hex_quality.h"
 #include "mesher/hex_reorder.h"
 #include "mesher/landmarks.h"
 
@@ -50,13 +54,10 @@ Vec3 parse_point(const std::string& text) {
   return p;
 }
 
-// Cell and point arrays of the input other than the quality arrays (write_vtu recomputes those), permuted.
+// The arrays in the new order.
 std::vector<MeshArray> permute_arrays(const std::vector<MeshArray>& arrays, const std::vector<int>& order) {
   std::vector<MeshArray> out;
   for (const MeshArray& a : arrays) {
-    if (std::find(std::begin(kVtuQualityArrays), std::end(kVtuQualityArrays), a.name) !=
-        std::end(kVtuQualityArrays))
-      continue;
     MeshArray p = a;
     p.values.clear();
     p.bits64.clear();
@@ -71,6 +72,71 @@ std::vector<MeshArray> permute_arrays(const std::vector<MeshArray>& arrays, cons
   return out;
 }
 
+// Whether `a` holds what write_vtu writes as its quality array `values`: Float64, one value per hex, equal
+// up to the last bits (inf for an inverted hex; NaN where the measure is NaN).
+bool is_hexbite_quality(const MeshArray& a, const std::vector<double>& values) {
+  if (a.vtk_type != MeshArray().vtk_type || a.components != 1 || a.values.size() != values.size())
+    return false;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double x = a.values[i], y = values[i];
+    const bool close = std::isfinite(y) && std::abs(x - y) <= 1e-12 * std::abs(y);
+    if (!(x == y || close || (std::isnan(x) && std::isnan(y)))) return false;
+  }
+  return true;
+}
+
+// The input's cell arrays split by their names: `own` the user's; `clashing` those named like a quality
+// array of write_vtu's but holding other values (a user's 'condition'), which the output's quality array of
+// that name replaces. Quality arrays that hexbite wrote are in neither: the writer recomputes them.
+struct CellArrays {
+  std::vector<MeshArray> own;
+  std::vector<std::string> clashing;
+};
+
+CellArrays split_cell_arrays(const HexMesh& mesh, const std::vector<MeshArray>& arrays) {
+  std::optional<HexQualityField> quality;  // computed when an array needs it
+  CellArrays out;
+  for (const MeshArray& a : arrays) {
+    const auto named = std::find(std::begin(kVtuQualityArrays), std::end(kVtuQualityArrays), a.name);
+    if (named == std::end(kVtuQualityArrays)) {
+      out.own.push_back(a);
+      continue;
+    }
+    if (!quality) quality = compute_hex_quality(mesh);
+    if (!is_hexbite_quality(a, vtu_quality_array(*quality, named - std::begin(kVtuQualityArrays))))
+      out.clashing.push_back(a.name);
+  }
+  return out;
+}
+
+// Warnings for what the output leaves out of the input. A .vtu carries the numeric arrays, except a user's
+// array under a quality array's name; .msh and .inp files carry no arrays at all.
+void warn_arrays_not_carried(const ReorderOptions& o, const CellArrays& cells,
+                             const std::vector<MeshArray>& point_arrays,
+                             const std::vector<std::string>& not_read) {
+  const bool vtu = lower_extension(o.output) == ".vtu";
+  for (std::size_t i = 0; vtu && i < cells.clashing.size(); ++i) {
+    const std::string& name = cells.clashing[i];
+    std::cerr << "hexbite: warning: cell array '" << name << "' of " << o.mesh
+              << " is not hexbite's quality array of that name (its values differ): " << o.output
+              << " holds hexbite's '" << name << "' (Float64) in its place; rename the array in " << o.mesh
+              << " to keep it.\n";
+  }
+  std::vector<std::string> lost;
+  if (!vtu) {
+    for (const MeshArray& a : cells.own) lost.push_back("cell array '" + a.name + "'");
+    for (const std::string& name : cells.clashing) lost.push_back("cell array '" + name + "'");
+    for (const MeshArray& a : point_arrays) lost.push_back("point array '" + a.name + "'");
+  }
+  lost.insert(lost.end(), not_read.begin(), not_read.end());
+  if (lost.empty()) return;
+  std::string list;
+  for (const std::string& item : lost) list += (list.empty() ? "" : ", ") + item;
+  std::cerr << "hexbite: warning: not carried over to " << o.output << ": " << list
+            << (vtu ? " (reorder carries the numeric cell and point arrays only).\n"
+                    : " (only a .vtu output carries arrays).\n");
+}
+
 void run_reorder(const ReorderOptions& o) {
   if (o.method == "rcm" && (!o.from.empty() || !o.landmarks.empty()))
     throw InputError(
@@ -78,7 +144,8 @@ void run_reorder(const ReorderOptions& o) {
         "its own start, so leave them out or use --method bfs");
   std::vector<MeshArray> cell_arrays, point_arrays;
   std::vector<std::string> not_read;
-  const HexMesh mesh = read_hex_mesh(o.mesh, &cell_arrays, &point_arrays, &not_read);
+  const HexMeshInput input = load_hex_mesh_input(o.mesh, &cell_arrays, &point_arrays, &not_read);
+  const HexMesh& mesh = input.mesh;
 
   const auto t0 = std::chrono::steady_clock::now();
   ReorderResult r;
@@ -118,14 +185,10 @@ void run_reorder(const ReorderOptions& o) {
     r = reorder_reverse_cuthill_mckee(mesh);
   }
   const double seconds = seconds_since(t0);
-  write_hex_mesh(o.output, r.mesh, permute_arrays(cell_arrays, r.hex_order),
+  const CellArrays cells = split_cell_arrays(mesh, cell_arrays);
+  write_hex_mesh(o.output, r.mesh, permute_arrays(cells.own, r.hex_order),
                  permute_arrays(point_arrays, r.node_order));
-  if (!not_read.empty()) {
-    std::string list;
-    for (const std::string& item : not_read) list += (list.empty() ? "" : ", ") + item;
-    std::cerr << "hexbite: warning: not carried over to " << o.output << ": " << list
-              << " (reorder carries the numeric cell and point arrays only).\n";
-  }
+  warn_arrays_not_carried(o, cells, point_arrays, not_read);
 
   if (o.json) {
     nlohmann::json j;
@@ -146,7 +209,11 @@ void run_reorder(const ReorderOptions& o) {
   out << "Reordered " << o.mesh << " (" << mesh.hexes.size() << " hexes, " << mesh.vertices.size()
       << " nodes) by "
       << (o.method == "bfs"
-              ? "breadth-first order from " + start_text + " (input hex " + std::to_string(r.start_hex) + ")"
+              ? "breadth-first order from " + start_text + " (input hex " + std::to_string(r.start_hex) +
+                    (input.element_tags.empty()
+                         ? std::string()
+                         : ", Gmsh element " + std::to_string(input.element_tags[r.start_hex])) +
+                    ")"
               : std::string("reverse Cuthill-McKee"))
       << "\n\n";
   char line[128];

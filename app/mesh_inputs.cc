@@ -38,7 +38,30 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
   return in;
 }
 
-void require_no_inverted_hexes(const HexMesh& mesh, const std::string& path, const std::string& why) {
+std::function<std::string(int)> HexMeshInput::hex_label() const {
+  if (element_tags.empty()) return {};
+  return [this](int h) { return " (Gmsh element " + std::to_string(element_tags[h]) + ")"; };
+}
+
+std::string mesh_size_warning(double largest_extent_mm) {
+  return implausible_size_warning(
+      largest_extent_mm, "mm",
+      "scale the mesh from <unit> to millimetres where it was made: hex mesh files "
+      "are read in mm, and no option sets their unit",
+      "mesh");
+}
+
+HexMeshInput load_hex_mesh_input(const std::string& path, std::vector<MeshArray>* cell_arrays,
+                                 std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
+  HexMeshInput in;
+  in.mesh = read_hex_mesh(path, cell_arrays, point_arrays, not_read, &in.element_tags);
+  const std::string warning = mesh_size_warning(largest_extent(in.mesh.vertices));
+  if (!warning.empty()) std::cerr << "hexbite: warning: '" << path << "': " << warning << '\n';
+  return in;
+}
+
+void require_no_inverted_hexes(const HexMeshInput& input, const std::string& path, const std::string& why) {
+  const HexMesh& mesh = input.mesh;
   const HexQualityField field = compute_hex_quality(mesh);
   std::vector<int> inverted;
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
@@ -46,7 +69,8 @@ void require_no_inverted_hexes(const HexMesh& mesh, const std::string& path, con
   if (inverted.empty()) return;
   const std::string count = std::to_string(inverted.size());
   throw InputError("'" + path + "' has " + count + " inverted " + (inverted.size() == 1 ? "hex" : "hexes") +
-                   " (a corner Jacobian <= 0), " + why + ": " + hex_list_text(mesh, inverted, 5) +
+                   " (a corner Jacobian <= 0), " + why + ": " +
+                   hex_list_text(mesh, inverted, 5, input.hex_label()) +
                    "; nothing written: re-mesh the surface (hexbite mesh), or find the worst hexes with "
                    "hexbite quality " +
                    path + " --worst " + count);

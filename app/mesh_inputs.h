@@ -7,10 +7,13 @@
 // surfaces, malformed landmark files) are InputErrors from the loaders.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "mesher/hex_mesh.h"
+#include "mesher/hex_mesh_io.h"
 #include "mesher/landmarks.h"
 #include "mesher/tri_surface.h"
 
@@ -28,9 +31,29 @@ TriSurface load_surface_input(const std::string& surface_file, const std::string
 MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& units,
                             const std::string& landmark_file);
 
+// A hex mesh read by `quality`, `refine`, `reorder` or `quad from-mesh`.
+struct HexMeshInput {
+  HexMesh mesh;
+  std::vector<long> element_tags;  // the Gmsh element tag of each hex of a .msh; empty for a .vtu
+  // For hex_list_text(): " (Gmsh element 9)" after hex h's 0-based number, as Gmsh names the hex; an empty
+  // function for a .vtu, whose hexes ParaView numbers 0-based as hexbite does. Valid while this lives.
+  std::function<std::string(int)> hex_label() const;
+};
+
+// Reads the hex mesh `path` (read_hex_mesh, with the arrays when asked for) and warns on standard error
+// when its size is no bone's: mesh files are read in mm and no option sets their unit, so one written in
+// metres comes out 1000 times too small.
+HexMeshInput load_hex_mesh_input(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
+                                 std::vector<MeshArray>* point_arrays = nullptr,
+                                 std::vector<std::string>* not_read = nullptr);
+
+// The size warning of load_hex_mesh_input() for a mesh whose largest side is `largest_extent_mm`, without
+// "hexbite: warning: "; empty for a plausible size.
+std::string mesh_size_warning(double largest_extent_mm);
+
 // For the commands that read a hex mesh and cannot work on an inverted one (`refine`, `quad from-mesh`):
-// throws an InputError naming the inverted hexes of `mesh` (read from `path`; a corner Jacobian <= 0 or NaN)
-// with their centroids, `why` they are refused, and what to do.
-void require_no_inverted_hexes(const HexMesh& mesh, const std::string& path, const std::string& why);
+// throws an InputError naming the inverted hexes of `input` (read from `path`; a corner Jacobian <= 0 or
+// NaN) with their centroids (and Gmsh element tags), `why` they are refused, and what to do.
+void require_no_inverted_hexes(const HexMeshInput& input, const std::string& path, const std::string& why);
 
 }  // namespace hexbite

@@ -65,8 +65,45 @@ void check_readable(const std::string& path, const char* what) {
     throw InputError("cannot read " + std::string(what) + " '" + path + "': the file is empty");
 }
 
-// Checks vertex coordinates and hex indices of a mesh just read; `where` names the file.
-void check_mesh(const HexMesh& mesh, const std::string& where) {
+// Two distinct vertices of hexes at exactly the same place leave the hexes on either side unconnected: the
+// face between them counted as boundary, refine moved its nodes onto the surface (the halves overlapped)
+// and the solver would see two loose bodies. Sorting the used vertices by their coordinates finds them in
+// O(n log n). Unused points may coincide: no hex joins through them.
+void check_coincident_vertices(const HexMesh& mesh, const std::string& where,
+                               const std::vector<long>& node_tags) {
+  std::vector<char> used(mesh.vertices.size(), 0);
+  for (const std::array<int, 8>& hex : mesh.hexes)
+    for (int v : hex) used[v] = 1;
+  std::vector<int> order;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    if (used[v]) order.push_back(static_cast<int>(v));
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::make_pair(mesh.vertices[a], a) < std::make_pair(mesh.vertices[b], b);
+  });
+  std::size_t pairs = 0, first = 0;
+  for (std::size_t i = 1; i < order.size(); ++i)
+    if (mesh.vertices[order[i]] == mesh.vertices[order[i - 1]] && pairs++ == 0) first = i;
+  if (pairs == 0) return;
+  const int a = order[first - 1], b = order[first];
+  const Vec3& p = mesh.vertices[a];
+  char place[128];
+  std::snprintf(place, sizeof place, "(%.9g, %.9g, %.9g) mm", p[0], p[1], p[2]);
+  // Named as the file numbers them: by their Gmsh node tags, or else 0-based.
+  const std::string names =
+      node_tags.empty() ? "vertices " + std::to_string(a) + " and " + std::to_string(b) + " (0-based)"
+                        : "nodes " + std::to_string(node_tags[a]) + " and " + std::to_string(node_tags[b]);
+  throw InputError(
+      where + ": " + names + " lie at the same place " + place +
+      " but are distinct, so the hexes using them are not joined there (their shared faces would count as "
+      "boundary)" +
+      (pairs > 1 ? "; " + std::to_string(pairs) + " such pairs in all" : std::string()) +
+      ": merge coincident nodes where the mesh was made (in Gmsh: 'Coherence Mesh;' after meshing, or "
+      "Geometry.AutoCoherence = 1 or BooleanFragments so that touching volumes share their faces)");
+}
+
+// Checks vertex coordinates and hex indices of a mesh just read; `where` names the file, `node_tags` its
+// Gmsh node tags (empty for a .vtu).
+void check_mesh(const HexMesh& mesh, const std::string& where, const std::vector<long>& node_tags = {}) {
   if (mesh.hexes.empty())
     throw InputError(where + " holds no hexahedra (" + std::to_string(mesh.vertices.size()) +
                      " points and no volume cells): give a hex mesh");
@@ -105,6 +142,7 @@ void check_mesh(const HexMesh& mesh, const std::string& where) {
                        std::to_string(sorted[i].second) +
                        " (0-based) have the same 8 vertices: a hexahedron listed twice; remove the copies "
                        "where the mesh was made");
+  check_coincident_vertices(mesh, where, node_tags);
 }
 
 void check_arrays(const std::vector<MeshArray>& arrays, std::size_t count, const char* kind,
@@ -167,6 +205,12 @@ std::vector<MeshArray> arrays_of(vtkFieldData* data) {
 
 }  // namespace
 
+const std::vector<double>& vtu_quality_array(const HexQualityField& quality, int i) {
+  const std::vector<double>* arrays[4] = {&quality.scaled_jacobian, &quality.condition, &quality.oddy,
+                                          &quality.jacobian};
+  return *arrays[i];
+}
+
 void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<MeshArray>& cell_arrays,
                const std::vector<MeshArray>& point_arrays) {
   std::set<std::string> names(std::begin(kVtuQualityArrays), std::end(kVtuQualityArrays));
@@ -195,9 +239,8 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
   grid->SetCells(VTK_HEXAHEDRON, cells);
 
   const HexQualityField q = compute_hex_quality(mesh);
-  const std::vector<double>* quality[4] = {&q.scaled_jacobian, &q.condition, &q.oddy, &q.jacobian};
   for (int i = 0; i < 4; ++i)
-    grid->GetCellData()->AddArray(make_vtk_array({kVtuQualityArrays[i], 1, *quality[i]}));
+    grid->GetCellData()->AddArray(make_vtk_array({kVtuQualityArrays[i], 1, vtu_quality_array(q, i)}));
   for (const MeshArray& a : cell_arrays) grid->GetCellData()->AddArray(make_vtk_array(a));
   for (const MeshArray& a : point_arrays) grid->GetPointData()->AddArray(make_vtk_array(a));
 
@@ -497,19 +540,41 @@ int gmsh_element_dimension(int type) {
   }
 }
 
+// "a 4-node tetrahedron" for the common Gmsh volume types other than the 8-node hexahedron.
+std::string gmsh_volume_element_name(int type) {
+  switch (type) {
+    case 4:
+      return "a 4-node tetrahedron";
+    case 6:
+      return "a 6-node prism";
+    case 7:
+      return "a 5-node pyramid";
+    case 11:
+      return "a 10-node tetrahedron";
+    case 12:
+      return "a 27-node hexahedron";
+    case 17:
+      return "a 20-node hexahedron";
+    default:
+      return "a volume element";
+  }
+}
+
 }  // namespace
 
-HexMesh read_msh(const std::string& path) {
+HexMesh read_msh(const std::string& path, std::vector<long>* element_tags) {
   check_readable(path, "Gmsh mesh");
   MshReader r(path);
   HexMesh mesh;
   std::unordered_map<long, int> node_index;
+  std::vector<long> node_tags, hex_tags;  // of mesh.vertices and mesh.hexes, for messages
   std::string line, version;
   bool have_format = false, have_nodes = false, have_elements = false;
   auto add_node = [&](long tag, const Vec3& p) {
     if (!node_index.emplace(tag, static_cast<int>(mesh.vertices.size())).second)
       r.fail("node tag " + std::to_string(tag) + " appears twice");
     mesh.vertices.push_back(p);
+    node_tags.push_back(tag);
   };
   std::map<std::array<long, 8>, std::pair<long, long>> hex_lines;  // sorted nodes -> (tag, line)
   auto add_element = [&](long tag, int type, const std::vector<long>& nodes) {
@@ -518,8 +583,11 @@ HexMesh read_msh(const std::string& path) {
       r.fail("element " + std::to_string(tag) + " has unknown element type " + std::to_string(type));
     if (dim < 3) return;
     if (type != 5)
-      r.fail("element " + std::to_string(tag) + " is a volume element of Gmsh type " + std::to_string(type) +
-             "; only 8-node hexahedra (type 5) are accepted");
+      r.fail("element " + std::to_string(tag) + " is " + gmsh_volume_element_name(type) + " (Gmsh type " +
+             std::to_string(type) +
+             "); only 8-node hexahedra (type 5) are accepted: give an all-hex mesh (in Gmsh, for instance "
+             "Mesh.SubdivisionAlgorithm = 2, which splits every element into hexahedra, with "
+             "Mesh.ElementOrder = 1), or mesh the surface with hexbite mesh");
     if (nodes.size() != 8) r.fail("hexahedron " + std::to_string(tag) + " does not have 8 nodes");
     std::array<int, 8> hex;
     for (int k = 0; k < 8; ++k) {
@@ -547,6 +615,7 @@ HexMesh read_msh(const std::string& path) {
              "): a hexahedron listed twice (Gmsh writes a volume's elements once per physical group that "
              "holds it): keep the volume in one physical group, or remove the copies");
     mesh.hexes.push_back(hex);
+    hex_tags.push_back(tag);
   };
 
   while (r.next_line(line)) {
@@ -559,8 +628,13 @@ HexMesh read_msh(const std::string& path) {
       if (file_type != 0) r.fail("binary .msh files are not supported; save the mesh as ASCII");
       r.expect_end("MeshFormat");
       have_format = true;
-    } else if (line == "$Nodes") {
-      if (!have_format) r.fail("$Nodes before $MeshFormat");
+    } else if (line == "$Nodes" || line == "$ParametricNodes") {
+      // MSH 2.2 with Mesh.SaveParametric writes $ParametricNodes: "tag x y z dim entity" and up to two
+      // parametric coordinates, which the 2.2 branch below leaves unread (4.1 keeps them in $Nodes).
+      const std::string section = line.substr(1);
+      if (!have_format) r.fail(line + " before $MeshFormat");
+      if (section == "ParametricNodes" && version != "2.2")
+        r.fail("$ParametricNodes belongs to format 2.2, but the file says " + version);
       if (version == "4.1") {
         auto s = r.numbers();
         long blocks = 0, count = 0, lo = 0, hi = 0;
@@ -601,7 +675,7 @@ HexMesh read_msh(const std::string& path) {
           add_node(tag, p);
         }
       }
-      r.expect_end("Nodes");
+      r.expect_end(section);
       have_nodes = true;
     } else if (line == "$Elements") {
       if (!have_nodes) r.fail("$Elements before $Nodes");
@@ -650,7 +724,8 @@ HexMesh read_msh(const std::string& path) {
   }
   if (!have_format) r.fail("no $MeshFormat section: not a Gmsh .msh file");
   if (!have_elements) r.fail("no $Elements section");
-  check_mesh(mesh, "Gmsh mesh '" + path + "'");
+  check_mesh(mesh, "Gmsh mesh '" + path + "'", node_tags);
+  if (element_tags != nullptr) *element_tags = std::move(hex_tags);
   return mesh;
 }
 
@@ -670,12 +745,16 @@ void write_hex_mesh(const std::string& path, const HexMesh& mesh, const std::vec
 }
 
 HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays,
-                      std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
-  if (lower_extension(path) != ".msh") return read_vtu(path, cell_arrays, point_arrays, not_read);
+                      std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read,
+                      std::vector<long>* element_tags) {
+  if (lower_extension(path) != ".msh") {
+    if (element_tags) element_tags->clear();
+    return read_vtu(path, cell_arrays, point_arrays, not_read);
+  }
   if (cell_arrays) cell_arrays->clear();
   if (point_arrays) point_arrays->clear();
   if (not_read) not_read->clear();
-  return read_msh(path);
+  return read_msh(path, element_tags);
 }
 
 }  // namespace hexbite

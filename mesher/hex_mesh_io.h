@@ -5,9 +5,11 @@
 // atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
 // hexahedra and throw InputError naming the file and what is wrong: missing, unreadable, not a mesh of that
 // format, a cell that is not a hexahedron (with its index and type), no hexahedron at all, a NaN or infinite
-// coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes). Orientation
-// is not checked here: that is the quality module's job (inverted hexes).
-// Cost: linear in the mesh size.
+// coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes), a hexahedron
+// listed twice, two distinct vertices of hexes at exactly the same place (hexes that touch without sharing
+// their nodes; unused points may coincide). Orientation is not checked here: that is the quality module's
+// job (inverted hexes).
+// Cost: O(n log n) in the mesh size (the sorts that find copies).
 #pragma once
 
 #include <cstdint>
@@ -43,6 +45,10 @@ struct IndexSet {
 // scaled_jacobian, condition (cube = 3), oddy and jacobian. Callers may not reuse these names.
 inline const char* const kVtuQualityArrays[4] = {"scaled_jacobian", "condition", "oddy", "jacobian"};
 
+struct HexQualityField;
+// The values write_vtu writes under kVtuQualityArrays[i], Float64 with one component.
+const std::vector<double>& vtu_quality_array(const HexQualityField& quality, int i);
+
 // Writes a .vtu file: binary appended, zlib-compressed, double coordinates, VTK_HEXAHEDRON cells, with the
 // quality arrays above and the caller's extra cell and point arrays (Float64). Throws std::invalid_argument
 // when an extra array has the wrong size or a reserved or duplicate name.
@@ -71,9 +77,11 @@ std::string format_inp_number(double v);
 // Gmsh's node order, which equals VTK's) tagged 1..m.
 void write_msh(const std::string& path, const HexMesh& mesh);
 
-// Reads a Gmsh ASCII .msh file, format 4.1 or 2.2. Points, lines and faces are skipped; hexahedra (type 5)
-// are kept; any other volume element is an InputError. All nodes are kept, in the file's order.
-HexMesh read_msh(const std::string& path);
+// Reads a Gmsh ASCII .msh file, format 4.1 or 2.2 (its nodes in $Nodes, or in 2.2 $ParametricNodes).
+// Points, lines and faces are skipped; hexahedra (type 5) are kept; any other volume element is an
+// InputError. All nodes are kept, in the file's order. When given, `element_tags` receives the file's
+// element tag of each hex, for messages that name a hex as Gmsh does.
+HexMesh read_msh(const std::string& path, std::vector<long>* element_tags = nullptr);
 
 // The hex mesh formats by the file name's extension (any case): .vtu (write_vtu, with the arrays), .inp
 // (write_inp, nodes and C3D8 elements only) or .msh (write_msh); the arrays go only into a .vtu. Throws
@@ -83,9 +91,11 @@ void write_hex_mesh(const std::string& path, const HexMesh& mesh,
                     const std::vector<MeshArray>& point_arrays = {});
 
 // Reads a .msh file (read_msh) by its extension (any case), any other name as a .vtu (read_vtu, which names
-// a file that is not one); the arrays come only from a .vtu (a .msh leaves them empty).
+// a file that is not one); the arrays come only from a .vtu (a .msh leaves them empty), the element tags
+// only from a .msh (a .vtu leaves them empty).
 HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
                       std::vector<MeshArray>* point_arrays = nullptr,
-                      std::vector<std::string>* not_read = nullptr);
+                      std::vector<std::string>* not_read = nullptr,
+                      std::vector<long>* element_tags = nullptr);
 
 }  // namespace hexbite

@@ -25,9 +25,10 @@ namespace {
 // The shared sentence of the two size warnings: the size as read, and the unit among mm, cm and m whose
 // reading of the file comes nearest to 100 mm (by ratio) within [lo, hi] mm, with `how` to give it ("<unit>"
 // in it is replaced by the unit). Empty when the size is within [lo, hi]. `say_only`: "only N mm across"
-// for a size under lo (the wording of the wide bounds' warning, kept as users' scripts match it).
+// for a size under lo (the wording of the wide bounds' warning, kept as users' scripts match it). `what`
+// names the object ("surface").
 std::string size_warning(double largest_extent_mm, const std::string& unit, double lo, double hi,
-                         bool say_only, const std::string& how) {
+                         bool say_only, const std::string& how, const std::string& what) {
   if (!(largest_extent_mm < lo || largest_extent_mm > hi)) return {};
   const double in_file_units = largest_extent_mm / stated_unit_to_mm(unit);
   std::string best;
@@ -40,9 +41,10 @@ std::string size_warning(double largest_extent_mm, const std::string& unit, doub
   }
   char text[400];
   std::snprintf(text, sizeof text,
-                "the surface is %s%.4g mm across (the largest side of its bounding box) with its coordinates "
+                "the %s is %s%.4g mm across (the largest side of its bounding box) with its coordinates "
                 "read as %s; a mandible is about 100 mm",
-                say_only && largest_extent_mm < lo ? "only " : "", largest_extent_mm, unit.c_str());
+                what.c_str(), say_only && largest_extent_mm < lo ? "only " : "", largest_extent_mm,
+                unit.c_str());
   if (best.empty()) {
     std::snprintf(text + std::strlen(text), sizeof text - std::strlen(text),
                   ", and no unit of mm, cm or m gives a size between %g and %g mm: scale the file to "
@@ -61,13 +63,13 @@ std::string size_warning(double largest_extent_mm, const std::string& unit, doub
 }  // namespace
 
 std::string implausible_size_warning(double largest_extent_mm, const std::string& unit,
-                                     const std::string& how) {
-  return size_warning(largest_extent_mm, unit, 0.5, 3000.0, true, how);
+                                     const std::string& how, const std::string& what) {
+  return size_warning(largest_extent_mm, unit, 0.5, 3000.0, true, how, what);
 }
 
 std::string unit_mismatch_warning(double largest_extent_mm, const std::string& unit, const std::string& how) {
   // A mandible is about 100 mm across.
-  return size_warning(largest_extent_mm, unit, 20.0, 500.0, false, how);
+  return size_warning(largest_extent_mm, unit, 20.0, 500.0, false, how, "surface");
 }
 
 std::string format_point_mm(const Vec3& p) {

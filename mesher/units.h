@@ -25,9 +25,9 @@ double stated_unit_to_mm(const std::string& unit);
 // mm, cm and m that would give a size nearest 100 mm within those bounds, and `how` to give it (e.g. "give
 // --units <unit>"; "<unit>" in it is replaced by the unit), or says that none does. Empty for plausible
 // sizes. (The commands that mesh any solid use these wide bounds; `hexbite run` uses
-// unit_mismatch_warning's mandible bounds.)
+// unit_mismatch_warning's mandible bounds.) `what` names the object: "surface", or "mesh" for a hex mesh.
 std::string implausible_size_warning(double largest_extent_mm, const std::string& unit,
-                                     const std::string& how);
+                                     const std::string& how, const std::string& what = "surface");
 
 // A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m, or um for
 // a NIfTI volume that states micrometres) is implausibly sized for a mandible: its largest side,

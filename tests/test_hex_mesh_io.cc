@@ -518,12 +518,136 @@ TEST(HexMeshIo, MshVersion22WithLowerDimensionalElements) {
       "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
       "$Elements\n1\n7 4 2 0 1 1 2 3 4\n$EndElements\n");
   std::string msg = test::message_of<InputError>([&] { read_msh(dir + "/tet.msh"); });
-  EXPECT_NE(msg.find("element 7"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("line 13"), std::string::npos) << msg;
+  // The type by name, and what to do (was "is a volume element of Gmsh type 4").
+  EXPECT_NE(msg.find("line 13: element 7 is a 4-node tetrahedron (Gmsh type 4); only 8-node hexahedra (type "
+                     "5) are accepted: give an all-hex mesh (in Gmsh, for instance Mesh.SubdivisionAlgorithm "
+                     "= 2"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("or mesh the surface with hexbite mesh"), std::string::npos) << msg;
 
   write_file(dir + "/junk.msh", "hello\n");
   EXPECT_NE(test::message_of<InputError>([&] { read_msh(dir + "/junk.msh"); }).find("not a Gmsh"),
             std::string::npos);
+}
+
+// Two hexes that touch but do not share their corner nodes (two Gmsh volumes meshed without Coherence Mesh)
+// were read as one mesh: quality counted the face between them as boundary and refine --surface moved its
+// nodes onto the surface, so the halves overlapped. Unused points may still coincide.
+TEST(HexMeshIo, CoincidentNodesOfHexesAreRefused) {
+  const std::string dir = temp_dir();
+  const std::string points = std::string(kCubePoints) + " 1 0 0 2 0 0 2 1 0 1 1 0 1 0 1 2 0 1 2 1 1 1 1 1";
+  write_file(dir + "/two.vtu",
+             ascii_vtu(2, "12 12", "0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15", "8 16", points, 16));
+  std::string msg = test::message_of<InputError>([&] { read_vtu(dir + "/two.vtu"); });
+  EXPECT_NE(msg.find("two.vtu': vertices 1 and 8 (0-based) lie at the same place (1, 0, 0) mm but are "
+                     "distinct"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("4 such pairs in all: merge coincident nodes where the mesh was made (in Gmsh: "
+                     "'Coherence Mesh;'"),
+            std::string::npos)
+      << msg;
+  // The same two hexes joined (shared nodes) read, with the now unused copies at the same places.
+  write_file(dir + "/joined.vtu",
+             ascii_vtu(2, "12 12", "0 1 2 3 4 5 6 7 1 9 10 2 5 13 14 6", "8 16", points, 16));
+  EXPECT_EQ(read_vtu(dir + "/joined.vtu").hexes.size(), 2u);
+
+  // In a .msh the nodes are named by their tags.
+  write_file(dir + "/two.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n16\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+             "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n21 1 0 0\n22 2 0 0\n23 2 1 0\n24 1 1 0\n25 1 0 1\n"
+             "26 2 0 1\n27 2 1 1\n28 1 1 1\n$EndNodes\n$Elements\n2\n1 5 2 1 1 1 2 3 4 5 6 7 8\n"
+             "2 5 2 2 2 21 22 23 24 25 26 27 28\n$EndElements\n");
+  msg = test::message_of<InputError>([&] { read_msh(dir + "/two.msh"); });
+  EXPECT_NE(msg.find("two.msh': nodes 2 and 21 lie at the same place (1, 0, 0) mm"), std::string::npos)
+      << msg;
+  const test::CommandResult r = run_hexbite({"quality", dir + "/two.vtu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("vertices 1 and 8 (0-based) lie at the same place"), std::string::npos) << r.err;
+}
+
+// Gmsh 2.2 with Mesh.SaveParametric writes its nodes in $ParametricNodes ("tag x y z dim entity u v"): it
+// was skipped, and the file refused with "$Elements before $Nodes".
+TEST(HexMeshIo, MshVersion22ParametricNodes) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/p.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$ParametricNodes\n8\n1 0 0 0 3 1\n2 1 0 0 0 2\n"
+             "3 1 1 0 1 3 0.5\n4 0 1 0 2 1 0.25 0.75\n5 0 0 1 3 1\n6 1 0 1 3 1\n7 1 1 1 3 1\n8 0 1 1 3 1\n"
+             "$EndParametricNodes\n$Elements\n1\n1 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n");
+  const HexMesh m = read_msh(dir + "/p.msh");
+  ASSERT_EQ(m.hexes.size(), 1u);
+  EXPECT_EQ(m.vertices[3], (Vec3{0, 1, 0}));
+  EXPECT_EQ(hex_quality(m.vertices.data()).scaled_jacobian, 1.0);
+}
+
+// Messages about a hex of a .msh input give its Gmsh element tag beside hexbite's 0-based index (refine said
+// "hex 1 at (1.50, 0.50, 0.50) mm" for the element Gmsh calls 9).
+TEST(HexMeshIo, InvertedHexesOfAMshAreNamedByTheirElementTags) {
+  const std::string dir = temp_dir();
+  // Two hexes side by side; the second (tag 9) lists its faces top first: inverted.
+  write_file(dir + "/inv.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n12\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+             "5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n9 2 0 0\n10 2 1 0\n11 2 0 1\n12 2 1 1\n$EndNodes\n"
+             "$Elements\n2\n4 5 2 1 1 1 2 3 4 5 6 7 8\n9 5 2 1 1 6 11 12 7 2 9 10 3\n$EndElements\n");
+  test::CommandResult r = run_hexbite({"refine", dir + "/inv.msh", "-o", dir + "/fine.vtu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("hex 1 (Gmsh element 9) at (1.50, 0.50, 0.50) mm"), std::string::npos) << r.err;
+  r = run_hexbite({"quality", dir + "/inv.msh", "--worst", "1"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("inverted hexes (0-based): 1 (Gmsh element 9)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Gmsh element"), std::string::npos) << r.out;
+  r = run_hexbite({"quality", dir + "/inv.msh", "--worst", "1", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["worst"][0]["gmsh_element"], 9);
+}
+
+// A mesh file in metres (Mesh.ScalingFactor = 0.001) was read in mm without a word: mesh files have no unit
+// option, so the commands that read one warn about a size no bone has.
+TEST(HexMeshIo, MeshOfNoBonesSizeIsWarnedAbout) {
+  const std::string dir = temp_dir();
+  HexMesh mesh = make_block_mesh(2, 2, 2);
+  for (Vec3& p : mesh.vertices)
+    for (double& c : p) c *= 0.005;
+  write_msh(dir + "/m.msh", mesh);
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"quality", dir + "/m.msh", "-q"},
+        std::vector<std::string>{"reorder", dir + "/m.msh", "-o", dir + "/r.msh", "-q"},
+        std::vector<std::string>{"refine", dir + "/m.msh", "-o", dir + "/f.msh", "-q"}}) {
+    const test::CommandResult r = run_hexbite(args);
+    EXPECT_EQ(r.exit_code, 0) << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find("hexbite: warning: '" + dir +
+                         "/m.msh': the mesh is only 0.01 mm across (the largest side of its bounding box) "
+                         "with its coordinates read as mm"),
+              std::string::npos)
+        << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find("If the file's coordinates are in m (10 mm across), scale the mesh from m to "
+                         "millimetres where it was made"),
+              std::string::npos)
+        << args[0] << ": " << r.err;
+  }
+  // A mesh in mm: no warning.
+  write_msh(dir + "/mm.msh", make_block_mesh(2, 2, 2));
+  EXPECT_EQ(run_hexbite({"quality", dir + "/mm.msh", "-q"}).err, "");
+
+  // refine --surface with the surface's --units m: the mesh does not lie on it, and the message sent the
+  // user back to --units ("give the surface the mesh was made from, in its units (--units, now m)").
+  write_msh(dir + "/cube.msh", make_block_mesh(2, 2, 2, {0, 0, 0}, {0.02, 0.02, 0.02}));
+  std::string obj = test::cubes_obj(1);  // a 20 mm cube, written here in metres
+  for (std::size_t at = obj.find("20"); at != std::string::npos; at = obj.find("20", at))
+    obj.replace(at, 2, "0.02");
+  write_file(dir + "/cube.obj", obj);
+  const test::CommandResult r = run_hexbite(
+      {"refine", dir + "/cube.msh", "--surface", dir + "/cube.obj", "--units", "m", "-o", dir + "/f.vtu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("does not lie on"), std::string::npos) << r.err;
+  EXPECT_NE(
+      r.err.find("; the mesh is 0.02 mm across, no bone's size: hex mesh files are read in mm, so scale "
+                 "the mesh to millimetres where it was made (--units sets the unit of the surface "
+                 "only)"),
+      std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("give the surface the mesh was made from"), std::string::npos) << r.err;
 }
 
 // Area vector of a planar or nearly planar quad: half the cross product of its diagonals.

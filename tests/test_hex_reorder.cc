@@ -291,6 +291,64 @@ TEST(HexReorderCommand, WhatIsNotCarriedOverIsNamed) {
   ASSERT_EQ(cells.size(), 5u);  // the four quality arrays and the material
   EXPECT_EQ(cells.back().name, "material");
   EXPECT_EQ(cells.back().vtk_type, VTK_INT);
+  // A .msh or .inp carries no arrays: the numeric ones were dropped without a word, and the warning said
+  // "(reorder carries the numeric cell and point arrays only)".
+  for (const char* ext : {".msh", ".inp"}) {
+    const auto lost = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/out" + ext, "-q"});
+    ASSERT_EQ(lost.exit_code, 0) << lost.err;
+    EXPECT_NE(lost.err.find("hexbite: warning: not carried over to " + dir + "/out" + ext +
+                            ": cell array 'material', cell array 'label' (text), field data 'TimeValue' "
+                            "(only a .vtu output carries arrays)."),
+              std::string::npos)
+        << lost.err;
+  }
+}
+
+// Arrays named like hexbite's quality arrays: a point array 'oddy' vanished (it cannot clash with the cell
+// arrays), and a user's Int32 cell array 'condition' was replaced by hexbite's without a word. An input that
+// hexbite wrote reorders without a warning.
+TEST(HexReorderCommand, ArraysNamedLikeQualityArrays) {
+  const std::string dir = temp_dir();
+  test::write_file(
+      dir + "/in.vtu",
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n<UnstructuredGrid>"
+      "<Piece NumberOfPoints=\"8\" NumberOfCells=\"1\">\n"
+      "<PointData><DataArray type=\"Float64\" Name=\"oddy\" format=\"ascii\">0 1 2 3 4 5 6 7</DataArray>"
+      "</PointData>\n<CellData><DataArray type=\"Int32\" Name=\"condition\" format=\"ascii\">7"
+      "</DataArray></CellData>\n<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+      "format=\"ascii\">0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1</DataArray></Points>\n<Cells>"
+      "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3 4 5 6 7</DataArray>"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">8</DataArray>"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">12</DataArray>"
+      "</Cells></Piece></UnstructuredGrid></VTKFile>\n");
+  auto r = run_hexbite({"reorder", dir + "/in.vtu", "-o", dir + "/out.vtu", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: cell array 'condition' of " + dir +
+                       "/in.vtu is not hexbite's quality array of that name (its values differ): " + dir +
+                       "/out.vtu holds hexbite's 'condition' (Float64) in its place; rename the array in " +
+                       dir + "/in.vtu to keep it."),
+            std::string::npos)
+      << r.err;
+  std::vector<MeshArray> cells, points;
+  read_vtu(dir + "/out.vtu", &cells, &points);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_EQ(points[0].name, "oddy");
+  EXPECT_EQ(points[0].values.size(), 8u);
+  ASSERT_EQ(cells.size(), 4u);  // hexbite's quality arrays
+  EXPECT_EQ(cells[1].name, "condition");
+  EXPECT_EQ(cells[1].vtk_type, VTK_DOUBLE);
+  EXPECT_EQ(cells[1].values, std::vector<double>{3.0});
+
+  // hexbite's own output, with its quality arrays and the point array 'oddy': no warning.
+  r = run_hexbite({"reorder", dir + "/out.vtu", "-o", dir + "/again.vtu", "--method", "rcm", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  HexMesh mesh = shuffled(make_block_mesh(3, 2, 2), 7);
+  mesh.vertices[0][0] -= 0.4;  // distorted hexes: quality values other than a cube's
+  write_vtu(dir + "/block.vtu", mesh);
+  r = run_hexbite({"reorder", dir + "/block.vtu", "-o", dir + "/block_rcm.vtu", "--method", "rcm", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
 }
 
 TEST(HexReorderCommand, BadInput) {
