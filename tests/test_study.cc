@@ -334,6 +334,44 @@ TEST(Study, SupportValuesTheStudySetAreNamedAtItsLines) {
   }
 }
 
+// More values a study set were named at the base's lines (hunt R): a material region's sphere radius that
+// holds no hex, a muscle's insertion radius that selects no facet, and a null that leaves no muscle.
+TEST(Study, RadiiAndNullsTheStudySetAreNamedAtItsLines) {
+  for (const auto& [set, fragment] : std::vector<std::pair<std::string, std::string>>{
+           {"materials.regions.implant.sphere.radius_mm: 0.01", "material region 'implant' holds no hex"},
+           {"muscles.pull.radius_mm: 0.5", "the insertion patch of muscle 'pull' selects no surface facets"},
+           {"muscles: ~", "no muscle is active"},
+       }) {
+    std::string study = kStudy;
+    study.replace(study.find("materials.default.E_MPa: 5500"), 29, set);
+    const std::string dir = study_folder(study);
+    std::string base = test::read_file(dir + "/base/cube.yaml");
+    base +=
+        "  regions:\n    - {name: implant, sphere: {center: [10.3, 10.7, 9.6], radius_mm: 6}, E_MPa: "
+        "110000}\n";
+    test::write_file(dir + "/base/cube.yaml", base);
+    const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << set << "\n" << r.err;
+    EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
+  }
+}
+
+// The warning that the supports hold the bone weakly was named at the base's first support when the study
+// had set the fixed components that made the hold weak.
+TEST(Study, AWeakHoldTheStudyMadeIsNamedAtItsLine) {
+  const std::string dir =
+      study_folder("name: weak\nbase: " + std::string(HEXBITE_SOURCE_DIR) +
+                   "/scenarios/lateral_bite_hard_nut.yaml\nvariants:\n  - name: weak\n    set:\n"
+                   "      supports.nut.fixed: [z]\n      supports.right_condyle.fixed: [x, y]\n"
+                   "      supports.left_condyle.fixed: [x, y]\n");
+  const test::CommandResult r =
+      test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out", "--levels", "0"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:6:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the supports hold the bone only weakly"), std::string::npos) << r.err;
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
