@@ -108,7 +108,13 @@ void add_report_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "HTML file to write")
       ->required()
       ->check(output_file({".html", ".htm"}));
-  cmd->add_option("--title", args->title, "Report title (default: the scenario's name)");
+  // A blank title fell back to the scenario's name ('') or wrote an empty heading ('   ') without a word.
+  cmd->add_option("--title", args->title, "Report title (default: the scenario's name)")
+      ->check([](const std::string& title) {
+        return title.find_first_not_of(" \t\r\n") == std::string::npos
+                   ? "the title is blank; give some text, or leave out --title for the scenario's name"
+                   : "";
+      });
   cmd->add_flag("--no-pictures", args->no_pictures,
                 "Leave out the pictures (they need solution.vtu and an X display)");
   cmd->add_flag("--json", args->json, "Print a JSON summary: the report's path, its pictures and warnings");

@@ -144,7 +144,7 @@ void run_study(const StudyCliOptions& o) {
         solve_run(r);
         // The variant's run folder, exactly as `hexbite run` writes it (app/cmd_run.cc).
         const auto t = std::chrono::steady_clock::now();
-        RunOutputs outputs(stage.stage_dir() + "/" + v.name);
+        RunOutputs outputs(stage.stage_dir() + "/" + v.name, /*in_stage=*/true);
         const std::vector<std::string> written = outputs.write(r, r.scenario.outputs.inp);
         nlohmann::ordered_json results = results_json(r, seconds_since(t));
         // scenario_file names the base; this says which study and which changes made these results, so

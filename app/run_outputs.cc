@@ -478,7 +478,7 @@ void refuse_inputs_among_outputs(const std::vector<std::pair<std::string, std::s
   }
 }
 
-RunOutputs::RunOutputs(const std::string& dir) : dir_(dir) {
+RunOutputs::RunOutputs(const std::string& dir, bool in_stage) : dir_(dir), in_stage_(in_stage) {
   while (dir_.size() > 1 && dir_.back() == '/') dir_.pop_back();  // as OutputStage names it
   const bool root = MpiSession::rank() == 0;
   on_all_ranks(
@@ -528,12 +528,13 @@ void RunOutputs::on_all_ranks(const std::function<void()>& step, Note note) {
   }
   if (kind == 0) return;
   message = named_in_dir(message, stage_dir_, dir_);
-  if (note != kNoNote)
+  const bool advise = note == kWriteNote && message.find(kWriteAdvice) == std::string::npos;
+  if (note != kNoNote && !in_stage_)
     message += "; the run kept none of its files and " +
                (created_dir_ ? "did not create '" + dir_ + "'" : "left '" + dir_ + "' as it was") +
-               (note == kWriteNote && message.find(kWriteAdvice) == std::string::npos
-                    ? std::string(": ") + kWriteAdvice + ", and run again"
-                    : "");
+               (advise ? std::string(": ") + kWriteAdvice + ", and run again" : "");
+  else if (advise)
+    message += std::string("; ") + kWriteAdvice + ", and run again";
   if (kind == 2) throw InputError(message);
   throw RunError(message);
 }

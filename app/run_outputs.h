@@ -54,7 +54,10 @@ void refuse_inputs_among_outputs(const std::vector<std::pair<std::string, std::s
 class RunOutputs {
  public:
   // Creates DIR if it is missing, and the hidden folder the files are written into until commit().
-  explicit RunOutputs(const std::string& dir);
+  // `in_stage`: DIR lies in another command's stage (a study's variant folder), which says itself what
+  // became of the user's folder; an error then does not add what became of DIR, a folder the user never
+  // sees (a study's message said "did not create 'out/ref'" of a folder that existed).
+  explicit RunOutputs(const std::string& dir, bool in_stage = false);
   // Removes what commit() did not move into DIR.
   ~RunOutputs();
   RunOutputs(const RunOutputs&) = delete;
@@ -80,6 +83,7 @@ class RunOutputs {
   std::string dir_;
   std::string stage_dir_;
   bool created_dir_ = false;
+  bool in_stage_ = false;
   std::unique_ptr<OutputStage> stage_;  // rank 0's
   std::vector<std::string> files_;
 };

@@ -377,6 +377,13 @@ const SourceLocation& point_place(const PointRef& point, const SourceLocation& i
   return point.where.line > 0 ? point.where : item;
 }
 
+// Where a patch or a sphere that holds nothing is named: at its radius when a study set it (written in
+// another file than the item; the base's point is not what changed), else at its point.
+const SourceLocation& sphere_place(const SourceLocation& radius_at, const PointRef& point,
+                                   const SourceLocation& item) {
+  return radius_at.line && radius_at.file != item.file ? radius_at : point_place(point, item);
+}
+
 constexpr double kProbeMaxOutsideMm = 5.0;
 
 // Probe points named by landmarks lie on the bone surface, and the mesh's boundary (bilinear faces through
@@ -494,7 +501,10 @@ void assign_materials(const Scenario& s, LevelResult& r) {
       std::snprintf(buf, sizeof buf,
                     "every hex centre inside it takes the material of a later region that overlaps it: "
                     "reorder or reshape the regions");
-    throw InputError(region.where.str() + ": material region '" + region.name + "' holds no hex of the " +
+    const SourceLocation& at = region.shape == RegionShape::kSphere
+                                   ? sphere_place(region.radius_at, region.center, region.where)
+                                   : region.where;
+    throw InputError(at.str() + ": material region '" + region.name + "' holds no hex of the " +
                      std::to_string(r.mesh.hexes.size()) + "-hex mesh, so it would change nothing; " + buf);
   }
 }
@@ -525,7 +535,7 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const Leve
     r.muscle_patches.push_back(
         coarser ? refined_patch(r.mesh, map, coarser->muscle_patches[r.muscle_patches.size()])
                 : select_patch(r.mesh, boundary, m.name, m.insertion.xyz, m.radius_mm,
-                               point_place(m.insertion, m.where),
+                               sphere_place(m.radius_at, m.insertion, m.where),
                                "the insertion patch of muscle '" + m.name + "'"));
     r.muscle_forces.push_back(muscle_force(m));
   }
@@ -533,11 +543,7 @@ LevelResult prepare_level(const Scenario& s, int level, HexMesh mesh, const Leve
     r.support_patches.push_back(
         coarser ? refined_patch(r.mesh, map, coarser->support_patches[r.support_patches.size()])
                 : select_patch(r.mesh, boundary, sup.name, sup.at.xyz, sup.radius_mm,
-                               // At a radius a study set (the base's point is not what changed).
-                               sup.radius_at.line && sup.radius_at.file != sup.where.file
-                                   ? sup.radius_at
-                                   : point_place(sup.at, sup.where),
-                               "support '" + sup.name + "'"));
+                               sphere_place(sup.radius_at, sup.at, sup.where), "support '" + sup.name + "'"));
   // Here, not before the solve: a contact that cannot push, or a probe far outside the mesh, must not cost a
   // study its earlier variants.
   r.contact_directions.assign(s.supports.size(), Vec3{0, 0, 0});
@@ -695,6 +701,14 @@ void require_every_body_held(const Scenario& s, const LevelResult& r, const Bodi
   }
 }
 
+// Where a warning that the supports hold the bone weakly is named: at the fixed components that a study set
+// (what it changed), else at the first support.
+const SourceLocation& hold_place(const Scenario& s) {
+  for (const Support& sup : s.supports)
+    if (sup.fixed_at.line && sup.fixed_at.file != sup.where.file) return sup.fixed_at;
+  return s.supports.front().where;
+}
+
 // The weakest rigid motion of every body against its supports; a warning for each weak one, after
 // `context` ("level 1, with contact 'x' released: "). The supports flagged in `left_out` do not count.
 std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& r, const Bodies& bodies,
@@ -741,7 +755,7 @@ std::vector<RigidMode> check_support_hold(const Scenario& s, const LevelResult& 
     // Numbers into a small buffer, the sentence as a string (a fixed buffer cut it when it grew).
     char values[64];
     std::snprintf(values, sizeof values, "hold %.2g, below %.2g", m.rho, kWeakSupportHold);
-    warn(s.supports.front().where.str() + ": " + context + text + motion + " (" + values +
+    warn(hold_place(s).str() + ": " + context + text + motion + " (" + values +
          "; the shipped scenarios 0.33 to 1.28), so the displacements and stresses depend mostly on how the "
          "patches resist that rotation. A body clamped at one end (a cantilever) is held so by design; "
          "otherwise fix more components of a support, or add a support away from that axis");

@@ -35,6 +35,9 @@
 #include <array>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -203,6 +206,28 @@ void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& pn
   write_file_atomically(png_path, png);
 }
 
+// Refuses a .pvtu whose piece file is missing, naming that file: VTK said only "File for piece 0 cannot be
+// read." of the .pvtu. The pieces lie beside it unless their Source is absolute, as VTK reads them.
+void require_pvtu_pieces(const std::string& pvtu_path) {
+  std::ifstream in(pvtu_path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string xml = text.str();
+  static const std::regex kPiece(R"re(<Piece\b[^>]*\bSource="([^"]*)")re");
+  std::size_t index = 0;
+  for (auto it = std::sregex_iterator(xml.begin(), xml.end(), kPiece); it != std::sregex_iterator();
+       ++it, ++index) {
+    const std::filesystem::path source((*it)[1].str());
+    const std::string piece =
+        (source.is_absolute() ? source : std::filesystem::path(pvtu_path).parent_path() / source).string();
+    std::error_code ec;
+    if (!std::filesystem::exists(piece, ec))
+      throw InputError("'" + piece + "' (piece " + std::to_string(index) + " of '" + pvtu_path +
+                       "') does not exist: a run under mpirun writes its pieces beside the .pvtu; copy them "
+                       "with it, or run the scenario again");
+  }
+}
+
 }  // namespace
 
 void render_surface_png(const TriSurface& surface, const std::string& png_path,
@@ -226,6 +251,7 @@ RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& fie
   // that pieces share appear once per piece, so the faces between pieces count as outer faces too; they
   // lie inside the bone and are hidden in the picture.
   const bool pieces = lower_extension(vtu_path) == ".pvtu";
+  if (pieces) require_pvtu_pieces(vtu_path);
   vtkSmartPointer<vtkXMLReader> reader;
   if (pieces)
     reader = vtkSmartPointer<vtkXMLPUnstructuredGridReader>::New();

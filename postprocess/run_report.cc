@@ -379,10 +379,10 @@ std::vector<std::string> report_warnings(const RunFigures& r) {
                   ", above 1e-8): do not trust the reactions and the bite "
                   "force; tighten solver.tolerance and run again.");
   for (const LevelFigures& l : r.levels)
-    if (r.max_displacement_limit && !(l.max_displacement <= *r.max_displacement_limit))
+    if (!(l.max_displacement <= r.max_displacement_limit))
       w.push_back("Small displacements: on level " + std::to_string(l.level) + " the largest displacement, " +
                   format_significant_digits(l.max_displacement, 3) +
-                  " mm, is more than 10 % of the bone's size (" + format_significant_digits(*r.bone_size, 4) +
+                  " mm, is more than 10 % of the bone's size (" + format_significant_digits(r.bone_size, 4) +
                   " mm), but linear elasticity holds only for small displacements: the run failed this "
                   "check and every figure of this report is meaningless. Check materials E_MPa (in MPa, "
                   "cortical bone about 11000), the muscles' max_force_N (in N) and that the supports hold "

@@ -72,6 +72,24 @@ class Checked {
     if (!k.value.is_number_integer()) wrong(k, "a whole number");
     return k.value.get<long>();
   }
+  // A count (hexes, nodes, iterations): the run writes none below `least`, so a smaller one was edited in.
+  long count(const Key& k, long least = 0) const {
+    const long n = whole(k);
+    if (n < least)
+      throw InputError("'" + file_ + "': key '" + k.path + "' is " + std::to_string(n) +
+                       ", but a run writes " +
+                       (least == 0 ? "no negative count" : "at least " + std::to_string(least)) +
+                       ", so the file was changed since: run the scenario again");
+    return n;
+  }
+  double positive(const Key& k) const {
+    const double x = number(k);
+    if (!(x > 0))
+      throw InputError("'" + file_ + "': key '" + k.path + "' is " + k.value.dump() +
+                       ", but a run writes a positive number, so the file was changed since: run the "
+                       "scenario again");
+    return x;
+  }
   bool boolean(const Key& k) const {
     if (!k.value.is_boolean()) wrong(k, "true or false");
     return k.value.get<bool>();
@@ -86,7 +104,9 @@ class Checked {
   }
 
   double number(const Key& parent, const std::string& name) const { return number(child(parent, name)); }
-  long whole(const Key& parent, const std::string& name) const { return whole(child(parent, name)); }
+  long count(const Key& parent, const std::string& name, long least = 0) const {
+    return count(child(parent, name), least);
+  }
   Vec3 vec(const Key& parent, const std::string& name) const { return vec(child(parent, name)); }
 
  private:
@@ -141,9 +161,9 @@ LevelFigures level_figures(const Checked& c, const Key& l, const std::vector<std
                         c.vec(p, "displacement_mm"), c.number(p, "von_mises_MPa")});
   }
   const Key solver = c.child(l, "solver");
-  f.iterations = c.whole(solver, "iterations");
+  f.iterations = c.count(solver, "iterations");
   f.solve_seconds = c.number(solver, "seconds");
-  f.ranks = c.whole(solver, "ranks");
+  f.ranks = c.count(solver, "ranks", 1);
   return f;
 }
 
@@ -159,7 +179,7 @@ void read_model(const Checked& c, const Key& top, RunFigures& r) {
     r.default_material = MaterialFigures{"", c.number(d, "E_MPa"), c.number(d, "poisson"), std::nullopt};
     c.each(materials, "regions", [&](const Key& m) {
       r.material_regions.push_back(
-          {c.text(c.child(m, "name")), c.number(m, "E_MPa"), c.number(m, "poisson"), c.whole(m, "hexes")});
+          {c.text(c.child(m, "name")), c.number(m, "E_MPa"), c.number(m, "poisson"), c.count(m, "hexes")});
     });
   }
   if (c.has(top, "muscles"))
@@ -252,13 +272,13 @@ RunFigures read_run_figures(const std::string& path) {
   }
   const Key mesh = c.child(top, "mesh");
   if (c.has(mesh, "core")) r.mesh_core = c.text(c.child(mesh, "core"));
-  r.degree = static_cast<int>(c.whole(mesh, "degree"));
+  r.degree = static_cast<int>(c.count(mesh, "degree", 1));
   const Key q = c.child(mesh, "quality");
   r.scaled_jacobian = quality(c, q, "scaled_jacobian");
   r.condition = quality(c, q, "condition");
   r.condition_verdict = quality(c, q, "condition_verdict");
   r.oddy = quality(c, q, "oddy");
-  r.inverted = c.whole(q, "inverted");
+  r.inverted = c.count(q, "inverted");
   if (c.has(mesh, "fidelity")) {
     const Key f = c.child(mesh, "fidelity");
     const auto figure = [&](const char* name) { return c.number_or_null(c.child(f, name)); };
@@ -280,25 +300,34 @@ RunFigures read_run_figures(const std::string& path) {
       r.support_hold.push_back(s);
     });
   if (c.has(top, "hexbite_version")) r.hexbite_version = c.text(c.child(top, "hexbite_version"));
-  if (c.has(top, "checks")) {
-    const Key checks = c.child(top, "checks");
-    r.max_displacement_limit = c.number(checks, "max_displacement_limit_mm");
-    r.bone_size = c.number(checks, "bone_size_mm");
-  }
+  // Required, as every key the report warns from: without it a run that failed its small-displacement
+  // check (exit 1, files kept) was reported without the warning.
+  const Key checks = c.child(top, "checks");
+  c.boolean(c.child(checks, "passed"));
+  c.positive(c.child(checks, "equilibrium_residual_limit"));
+  r.max_displacement_limit = c.positive(c.child(checks, "max_displacement_limit_mm"));
+  r.bone_size = c.positive(c.child(checks, "bone_size_mm"));
   read_model(c, top, r);
   std::vector<std::string> support_order;
   for (const SupportFigures& s : r.supports) support_order.push_back(s.name);
   r.coarse = level_figures(c, top, support_order);
-  r.coarse.hexes = c.whole(mesh, "hexes");
-  r.coarse.nodes = c.whole(mesh, "nodes");
-  r.coarse.dofs = c.whole(mesh, "dofs");
+  r.coarse.hexes = c.count(mesh, "hexes", 1);
+  r.coarse.nodes = c.count(mesh, "nodes", 1);
+  r.coarse.dofs = c.count(mesh, "dofs");
   const Key validation = c.child(top, "validation");
   c.each(validation, "levels", [&](const Key& l) {
     LevelFigures f = level_figures(c, l, support_order);
-    f.level = static_cast<int>(c.whole(l, "level"));
-    f.hexes = c.whole(l, "hexes");
-    f.nodes = c.whole(l, "nodes");
-    f.dofs = c.whole(l, "dofs");
+    const Key level = c.child(l, "level");
+    f.level = static_cast<int>(c.whole(level));
+    // The levels are 0, 1, 2, ... in order (docs/running.md): the report labels its rows and warnings so.
+    if (f.level != static_cast<long>(r.levels.size()))
+      throw InputError("'" + path + "': key '" + level.path + "' is " + level.value.dump() + ", but " +
+                       "validation.levels holds level 0 first and one more in each entry, so it must be " +
+                       std::to_string(r.levels.size()) +
+                       "; the file was changed since: run the scenario again");
+    f.hexes = c.count(l, "hexes", 1);
+    f.nodes = c.count(l, "nodes", 1);
+    f.dofs = c.count(l, "dofs");
     r.levels.push_back(f);
   });
   if (r.levels.empty())

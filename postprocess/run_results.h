@@ -119,8 +119,8 @@ struct RunFigures {
   std::vector<LevelFigures> levels;  // validation.levels, level 0 first
   // validation.relative_change: (last level - previous) / |last level|; none without a validation level.
   std::optional<double> change_bite_force, change_max_displacement, change_strain_energy;
-  // checks: the run's small-displacement limit (10 % of bone_size_mm); none in older files.
-  std::optional<double> max_displacement_limit, bone_size;
+  // checks: the run's small-displacement limit (10 % of bone_size_mm).
+  double max_displacement_limit = 0, bone_size = 0;
 };
 
 // Reads RUN_DIR/results.json (`path`). InputError for a missing file (saying to run `hexbite run` first),

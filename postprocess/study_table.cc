@@ -71,11 +71,28 @@ std::string markdown_cell(std::string text) {
   return text;
 }
 
-// "362.04", or "362.04 (-1.4 %)" with the relative change; "—" for a missing figure.
-std::string markdown_figure(const json& value, const json& change, int decimals) {
+// `text` as a Markdown code span: fenced by one backtick more than its longest run of backticks, with a space
+// inside the fences when it starts or ends with one (CommonMark), so that a backtick in a set value does not
+// end the span.
+std::string markdown_code(const std::string& text) {
+  std::size_t longest = 0, run = 0;
+  for (char c : text) {
+    run = c == '`' ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  const std::string fence(longest + 1, '`');
+  const std::string pad = !text.empty() && (text.front() == '`' || text.back() == '`') ? " " : "";
+  return fence + pad + text + pad + fence;
+}
+
+// "362.04", or "362.04 (-1.4 %)" with the relative change when `compared` (not the reference's own row);
+// "—" for a missing figure, "362.04 (—)" for a change that has none (the reference's figure is missing or
+// zero).
+std::string markdown_figure(const json& value, const json& change, bool compared, int decimals) {
   if (!value.is_number()) return "—";
   std::string text = format_table_number(value.get<double>(), decimals, 0);
-  if (change.is_number()) {
+  if (compared && !change.is_number()) return text + " (—)";
+  if (compared) {
     // One decimal: a report compares variants by per cent, and the round-off of equal figures (1e-13 %)
     // reads as 0.0 %; study.csv and study.json keep every digit.
     const double percent = 100.0 * change.get<double>();
@@ -86,13 +103,37 @@ std::string markdown_figure(const json& value, const json& change, int decimals)
   return text;
 }
 
+// A value of `set` in YAML's flow style, as a study writes it: [x, y, z], {right: 0.8, left: 0.47}. Text
+// that YAML would read otherwise in a list or a mapping (a comma, a bracket, a quote, nothing) is quoted.
+std::string yaml_flow(const json& value) {
+  const auto dump = [](const json& v) { return v.dump(-1, ' ', false, json::error_handler_t::replace); };
+  if (value.is_array()) {
+    std::string out;
+    for (const json& item : value) out += (out.empty() ? "" : ", ") + yaml_flow(item);
+    return "[" + out + "]";
+  }
+  if (value.is_object()) {
+    std::string out;
+    for (const auto& [key, item] : value.items())
+      out += (out.empty() ? "" : ", ") + yaml_flow(json(key)) + ": " + yaml_flow(item);
+    return "{" + out + "}";
+  }
+  if (!value.is_string()) return dump(value);
+  const std::string& text = value.get_ref<const std::string&>();
+  const bool plain = !text.empty() && text.find_first_of(",[]{}#\"'\n\r\t") == std::string::npos &&
+                     text.find(": ") == std::string::npos && text.back() != ':' && text.front() != ' ' &&
+                     text.back() != ' ' && std::string("&*!|>%@?").find(text.front()) == std::string::npos &&
+                     text.rfind("- ", 0) != 0 && text != "~" && text != "null" && text != "Null" &&
+                     text != "NULL";
+  return plain ? text : dump(value);
+}
+
 }  // namespace
 
 std::string study_changes(const json& set, bool abbreviate) {
   std::string out;
   for (const auto& [path, value] : set.items()) {
-    std::string text = value.is_string() ? value.get<std::string>()
-                                         : value.dump(-1, ' ', false, json::error_handler_t::replace);
+    std::string text = value.is_string() ? value.get<std::string>() : yaml_flow(value);
     if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
     // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell.
     std::string line;
@@ -179,14 +220,14 @@ std::string study_markdown(const json& study) {
     const bool reference = i == 0;  // its changes against itself are zero: shown without them
     const std::string set = study_changes(v["set"], true);
     out << "| " << markdown_cell(v["name"].get<std::string>()) << " | "
-        << (set.empty() ? "(none)" : "`" + markdown_cell(set) + "`") << " | " << v["level"].dump() << " | "
+        << (set.empty() ? "(none)" : markdown_code(markdown_cell(set))) << " | " << v["level"].dump() << " | "
         << v["hexes"].dump() << " |";
     for (const Figure& f : kFigures)
-      out << ' ' << markdown_figure(v[f.key], reference ? json() : change[f.key], f.decimals) << " |";
+      out << ' ' << markdown_figure(v[f.key], change[f.key], !reference, f.decimals) << " |";
     for (const std::string& s : supports) {
       out << ' '
           << (released(v, s) ? "0 (released)"
-                             : markdown_figure(reaction(v, s), reference ? json() : reaction(change, s), 2))
+                             : markdown_figure(reaction(v, s), reaction(change, s), !reference, 2))
           << " |";
     }
     out << '\n';

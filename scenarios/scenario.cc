@@ -74,6 +74,14 @@ std::vector<std::string> closest_names(const std::string& given, const std::vect
   return out;
 }
 
+// A key's place for messages about its value: the key's, or in a study's variant that set the value
+// (`set: {supports: []}`, `set: {supports.floor.contact: true}`, `set: {activation_pattern: null}`) the
+// study's line, where it was written. (A null value of the key's own file is placed at its key.)
+SourceLocation written_at(const Map& map, const std::string& key) {
+  const Value& v = map.get(key);
+  return v.at.file != map.key_at(key).file ? v.at : map.key_at(key);
+}
+
 double to_number(const Value& v) {
   const std::optional<double> x = plain_number(v.node);
   if (!x) fail(v.at, v.path + " must be a number, " + number_expected(v.node));
@@ -433,6 +441,7 @@ Materials parse_materials(const Value& v) {
         const Map s(r.get("sphere"), {"center", "radius_mm"});
         region.center = to_point(s.require("center", "center: [0, -30, 20]"));
         region.radius_mm = positive(s.require("radius_mm", "radius_mm: 5"), "a radius in mm");
+        region.radius_at = written_at(s, "radius_mm");
       } else {
         region.shape = RegionShape::kBox;
         const Map b(r.get("box"), {"min", "max"});
@@ -484,8 +493,10 @@ Muscle parse_muscle(const Value& item) {
   const Map map(item, {"name", "insertion", "radius_mm", "origin", "direction", "max_force_N", "activation"});
   Muscle m = default_muscle(to_string(map.require("name", "name: right_superficial_masseter")), item.at);
   if (auto x = map.find("insertion")) m.insertion = to_point(*x);
-  if (auto x = map.find("radius_mm"))
+  if (auto x = map.find("radius_mm")) {
     m.radius_mm = patch_radius(*x, "the insertion patch radius in mm, e.g. 10");
+    m.radius_at = written_at(map, "radius_mm");
+  }
   if (map.has("origin") && map.has("direction"))
     fail(map.key_at("direction"),
          "muscle " + quote(m.name) +
@@ -568,13 +579,6 @@ std::vector<Muscle> parse_activation_pattern(const Source& ctx, const Value& v) 
   return muscles;
 }
 
-// A key's place for messages about its value: the key's, or in a study's variant that set the value
-// (`set: {supports: []}`, `set: {supports.floor.contact: true}`) the study's line, where it was written.
-SourceLocation written_at(const Map& map, const std::string& key) {
-  const Value& v = map.get(key);
-  return !v.node.IsNull() && v.at.file != map.key_at(key).file ? v.at : map.key_at(key);
-}
-
 Support parse_support(const Value& item) {
   const Map map(item, {"name", "at", "radius_mm", "fixed", "spring_N_per_mm3", "bite", "contact"});
   Support s;
@@ -595,6 +599,7 @@ Support parse_support(const Value& item) {
              "or elastic, keep one");
   }
   if (auto x = map.find("fixed")) {
+    s.fixed_at = written_at(map, "fixed");
     const auto items = to_list(*x);
     if (items.empty())
       fail(x->at, "support " + quote(s.name) +

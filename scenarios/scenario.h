@@ -117,6 +117,7 @@ struct MaterialRegion {
   PointRef min, max;  // kBox: opposite corners, min below max in every coordinate
   MaterialSpec material;
   SourceLocation where;
+  SourceLocation radius_at;  // where a sphere's radius_mm was written: a study's line when the study set it
 };
 
 struct Materials {
@@ -135,8 +136,9 @@ struct Muscle {
   double activation = 0;
   Vec3 line_of_action{};  // unit vector, filled in by resolve_points()
   SourceLocation where;
-  SourceLocation name_at;   // where the name was written when not at `where` (empty: at where)
-  std::string pattern_key;  // the activation_pattern key it came from ("superficial_masseter"), or empty
+  SourceLocation name_at;    // where the name was written when not at `where` (empty: at where)
+  SourceLocation radius_at;  // where radius_mm was written (empty: the default), as Support::radius_at
+  std::string pattern_key;   // the activation_pattern key it came from ("superficial_masseter"), or empty
 };
 
 struct Support {
@@ -152,8 +154,9 @@ struct Support {
   SourceLocation where;
   // Where the name was written: a study that renames the support (supports.x.name) wrote it in the study
   // file, and a clash of names is named there. The same for the radius and the spring (messages about a
-  // patch that selects nothing, or a spring the CalculiX export cannot write).
-  SourceLocation name_at, radius_at, spring_at;
+  // patch that selects nothing, or a spring the CalculiX export cannot write), and the fixed components (a
+  // warning that the supports hold the bone weakly).
+  SourceLocation name_at, radius_at, spring_at, fixed_at;
 };
 
 enum class LinearSolverChoice { kAuto, kCgAmg, kDirect };

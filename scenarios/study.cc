@@ -30,8 +30,10 @@ std::string choices(const std::string& given, const std::vector<std::string>& va
   return hint + " (the " + noun + " are " + join_quoted(valid) + ")";
 }
 
-// A YAML value as JSON, for study.json's `set`: text stays text when quoted, plain scalars become the
-// number, boolean or null they read as.
+// A YAML value as JSON, for study.json's `set`: the changes as written. A scalar is its text, quoted or
+// not: which type it has is the scenario key's to say (`name: 007` is the text 007, `E_MPa: 5500` the
+// number 5500, `fixed: [x, y, z]` three axes), and YAML's own reading of a plain scalar (7, 5500, true for
+// `y`) misrecorded text. Nothing (`~`, `null`, no value) is null, as the scenario reads it.
 json to_json(const YAML::Node& node) {
   if (!node.IsDefined() || node.IsNull()) return json();
   if (node.IsSequence()) {
@@ -44,14 +46,6 @@ json to_json(const YAML::Node& node) {
     for (auto it = node.begin(); it != node.end(); ++it) out[it->first.Scalar()] = to_json(it->second);
     return out;
   }
-  if (is_quoted(node)) return node.Scalar();
-  long long integer = 0;
-  double number = 0;
-  bool flag = false;
-  if (decimal_whole_number(node, &integer) && node.Scalar().find_first_of(".eE") == std::string::npos)
-    return integer;
-  if (YAML::convert<double>::decode(node, number) && std::isfinite(number)) return number;
-  if (YAML::convert<bool>::decode(node, flag)) return flag;
   return node.Scalar();
 }
 
@@ -192,13 +186,15 @@ Study load_study(const std::string& path) {
     study.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x, kTextHint);
 
   const Value& base = map.require("base", "base: ../lateral_bite_hard_nut.yaml (a scenario file)");
-  fs::path base_path(to_string(base));
+  const std::string given =
+      to_string(base, "give the base scenario's file path, e.g. base: ../lateral_bite_hard_nut.yaml");
+  fs::path base_path(given);
   if (base_path.is_relative()) base_path = study_source.folder / base_path;
   study.base = base_path.lexically_normal().string();
   std::error_code error;
   if (!fs::is_regular_file(study.base, error))
-    fail(base.at, "base scenario " + quote(to_string(base)) +
-                      (study.base == to_string(base) ? "" : " (resolved to " + quote(study.base) + ")") +
+    fail(base.at, "base scenario " + quote(given) +
+                      (study.base == given ? "" : " (resolved to " + quote(study.base) + ")") +
                       " does not exist or is not a file; give a scenario file relative to the study file's "
                       "folder, or an absolute path");
   const std::string base_text = read_yaml_text(study.base, "scenario");

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -428,6 +429,66 @@ TEST_F(Report, BadInputIsRefusedWithExit2AndWritesNothing) {
   // The not-JSON case says what is wrong at that line.
   EXPECT_NE(run_hexbite({"report", dir + "/cut", "-o", out, "--no-pictures"}).err.find("not JSON"),
             std::string::npos);
+}
+
+// A results.json without `checks` (hand-edited or cut) was reported without the small-displacement warning
+// of a run that failed it; other hand-edited values that no run writes were printed as they were, and a
+// blank --title fell back to the scenario's name or wrote an empty heading.
+TEST_F(Report, ValuesNoRunWritesAndABlankTitleAreRefused) {
+  const std::string dir = temp_dir(), out = dir + "/r.html";
+  const auto edited = [&](const std::string& name, const std::function<void(json&)>& edit) {
+    json j = *results_;
+    edit(j);
+    fs::create_directories(dir + "/" + name);
+    write_file(dir + "/" + name + "/results.json", j.dump(1));
+    return dir + "/" + name;
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {edited("no_checks", [](json& j) { j.erase("checks"); }), "key 'checks' is missing"},
+      {edited("passed", [](json& j) { j["checks"]["passed"] = "yes"; }),
+       "key 'checks.passed' is a string, expected true or false"},
+      {edited("limit", [](json& j) { j["checks"]["max_displacement_limit_mm"] = 0; }),
+       "key 'checks.max_displacement_limit_mm' is 0, but a run writes a positive number"},
+      {edited("hexes", [](json& j) { j["mesh"]["hexes"] = -5; }),
+       "key 'mesh.hexes' is -5, but a run writes at least 1"},
+      {edited("level", [](json& j) { j["validation"]["levels"][1]["level"] = 2; }),
+       "key 'validation.levels[1].level' is 2, but validation.levels holds level 0 first and one more in "
+       "each "
+       "entry, so it must be 1"},
+  };
+  for (const auto& [folder, fragment] : cases) {
+    const test::CommandResult r = run_hexbite({"report", folder, "-o", out, "--no-pictures"});
+    EXPECT_EQ(r.exit_code, 2) << folder << "\n" << r.err;
+    EXPECT_NE(r.err.find(fragment), std::string::npos) << fragment << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  for (const char* title : {"", "   "}) {
+    const test::CommandResult r =
+        run_hexbite({"report", *run_dir_, "-o", out, "--no-pictures", "--title", title});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("--title"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("the title is blank"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// A .pvtu whose piece is missing was "cannot read 'solution.pvtu' ... (VTK: File for piece 0 cannot be
+// read.)"; the missing piece is named.
+TEST_F(Report, AMissingPieceOfTheSolutionIsNamed) {
+  const std::string dir = temp_dir(), out = dir + "/r.html";
+  write_file(dir + "/results.json", read_file(*run_dir_ + "/results.json"));
+  write_file(dir + "/solution.pvtu",
+             "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\">\n"
+             "  <PUnstructuredGrid GhostLevel=\"0\">\n    <PPoints>\n      <PDataArray type=\"Float64\" "
+             "NumberOfComponents=\"3\"/>\n    </PPoints>\n    <Piece Source=\"solution_0.vtu\"/>\n"
+             "  </PUnstructuredGrid>\n</VTKFile>\n");
+  const test::CommandResult r = run_hexbite({"report", dir, "-o", out}, display_launcher());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(
+      r.err.find("'" + dir + "/solution_0.vtu' (piece 0 of '" + dir + "/solution.pvtu') does not exist"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // The pictures are of the run whose figures the report prints: a solution.vtu beside another run's

@@ -115,7 +115,7 @@ TEST_F(CubeStudy, HalfTheModulusDoublesDisplacementAndEnergyAndKeepsStressesAndF
   EXPECT_NEAR(soft["relative_to_reference"]["max_displacement_mm"].get<double>(), 1.0, 2e-6);
   EXPECT_NEAR(soft["relative_to_reference"]["von_mises_max_MPa"].get<double>(), 0.0, 1e-6);
   EXPECT_EQ(ref["relative_to_reference"]["strain_energy_mJ"].get<double>(), 0.0);
-  EXPECT_EQ(soft["set"], json::parse(R"({"materials.default.E_MPa": 5500})"));
+  EXPECT_EQ(soft["set"], json::parse(R"({"materials.default.E_MPa": "5500"})"));
 }
 
 TEST_F(CubeStudy, AVariantWithoutABiteHasNoBiteForceInAnyTable) {
@@ -129,7 +129,7 @@ TEST_F(CubeStudy, AVariantWithoutABiteHasNoBiteForceInAnyTable) {
   };
   EXPECT_EQ(csv_cells(rows[3])[column("bite_force_N")], "");
   const std::string md = test::read_file(*dir_ + "/out/study.md");
-  EXPECT_NE(md.find("| no_bite | `supports.base.bite: false; outputs: {\"bite_force\":false}` | 0 |"),
+  EXPECT_NE(md.find("| no_bite | `supports.base.bite: false; outputs: {bite_force: false}` | 0 |"),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| — |"), std::string::npos) << md;
@@ -194,7 +194,7 @@ TEST_F(CubeStudy, AVariantsResultsAndReportNameTheStudyAndTheChanges) {
   EXPECT_EQ(soft["scenario_file"], *dir_ + "/base/cube.yaml");
   EXPECT_EQ(soft["study"],
             json::parse(R"({"name": "stiffness what-if", "file": ")" + *dir_ +
-                        R"(/study.yaml", "variant": "soft", "set": {"materials.default.E_MPa": 5500}})"));
+                        R"(/study.yaml", "variant": "soft", "set": {"materials.default.E_MPa": "5500"}})"));
   for (const auto& [name, says] :
        {std::pair<std::string, std::string>{"soft", "the scenario with materials.default.E_MPa: 5500"},
         {"reference", "the scenario as it is"}}) {
@@ -334,6 +334,44 @@ TEST(Study, SupportValuesTheStudySetAreNamedAtItsLines) {
   }
 }
 
+// More values a study set were named at the base's lines (hunt R): a material region's sphere radius that
+// holds no hex, a muscle's insertion radius that selects no facet, and a null that leaves no muscle.
+TEST(Study, RadiiAndNullsTheStudySetAreNamedAtItsLines) {
+  for (const auto& [set, fragment] : std::vector<std::pair<std::string, std::string>>{
+           {"materials.regions.implant.sphere.radius_mm: 0.01", "material region 'implant' holds no hex"},
+           {"muscles.pull.radius_mm: 0.5", "the insertion patch of muscle 'pull' selects no surface facets"},
+           {"muscles: ~", "no muscle is active"},
+       }) {
+    std::string study = kStudy;
+    study.replace(study.find("materials.default.E_MPa: 5500"), 29, set);
+    const std::string dir = study_folder(study);
+    std::string base = test::read_file(dir + "/base/cube.yaml");
+    base +=
+        "  regions:\n    - {name: implant, sphere: {center: [10.3, 10.7, 9.6], radius_mm: 6}, E_MPa: "
+        "110000}\n";
+    test::write_file(dir + "/base/cube.yaml", base);
+    const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << set << "\n" << r.err;
+    EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
+  }
+}
+
+// The warning that the supports hold the bone weakly was named at the base's first support when the study
+// had set the fixed components that made the hold weak.
+TEST(Study, AWeakHoldTheStudyMadeIsNamedAtItsLine) {
+  const std::string dir =
+      study_folder("name: weak\nbase: " + std::string(HEXBITE_SOURCE_DIR) +
+                   "/scenarios/lateral_bite_hard_nut.yaml\nvariants:\n  - name: weak\n    set:\n"
+                   "      supports.nut.fixed: [z]\n      supports.right_condyle.fixed: [x, y]\n"
+                   "      supports.left_condyle.fixed: [x, y]\n");
+  const test::CommandResult r =
+      test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out", "--levels", "0"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:6:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the supports hold the bone only weakly"), std::string::npos) << r.err;
+}
+
 // A bad study exits with 2 before anything is written, naming the study file and `line`, and `message`.
 void expect_refused(const std::string& study, int line, const std::string& message) {
   const std::string dir = study_folder(study);
@@ -371,7 +409,7 @@ TEST(StudyTable, AReleasedContactIsMarkedNotAMeasuredZero) {
   EXPECT_EQ(study["variants"][1]["relative_to_reference"]["reactions"]["molar"], 0.0);
   const std::string md = study_markdown(study);
   EXPECT_NE(md.find("| 0 (released) |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| 26.00 |"), std::string::npos) << md;  // no per cent against a released 0
+  EXPECT_NE(md.find("| 26.00 (—) |"), std::string::npos) << md;  // no per cent against a released 0
   const std::string csv = study_csv(study);
   EXPECT_NE(csv.find(",released_contacts\n"), std::string::npos) << csv;
   EXPECT_NE(csv.find(",premolar\n"), std::string::npos) << csv;
@@ -403,6 +441,46 @@ TEST(StudyTable, ALineBreakInAChangeStaysInItsRow) {
   const std::string csv = study_csv(study_json(table));
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;  // header, one row
   EXPECT_NE(csv.find(",description: two lines,"), std::string::npos) << csv;
+}
+
+// studies.md promises "—" for a relative change whose reference figure is missing or zero; study.md showed
+// the variant's figure alone ("362.59"), as for the reference's own row.
+TEST(StudyTable, AChangeWithoutAReferenceFigureIsADash) {
+  StudyTable table;
+  for (const char* name : {"reference", "variant"}) {
+    StudyRow row;
+    row.name = name;
+    row.set = nlohmann::ordered_json::object();
+    if (std::string(name) == "variant")
+      row.bite_force_N = 362.59;  // the reference has outputs.bite_force off
+    row.max_displacement_mm = 0.1;
+    row.reactions = {{"nut", std::string(name) == "reference" ? 0.0 : 362.59}};  // a zero reference
+    table.rows.push_back(row);
+  }
+  const std::string md = study_markdown(study_json(table));
+  const std::vector<std::string> rows = split(md, '\n');
+  ASSERT_EQ(rows.size(), 4u) << md;
+  EXPECT_EQ(rows[2], "| reference | (none) | 0 | 0 | — | 0.10000 | 0.000 | 0.000 | 0.00000 | 0.00 |") << md;
+  EXPECT_EQ(rows[3],
+            "| variant | (none) | 0 | 0 | 362.59 (—) | 0.10000 (0.0 %) | 0.000 (—) | 0.000 (—) | 0.00000 (—) "
+            "| 362.59 (—) |")
+      << md;
+}
+
+// A backtick in a set value ended study.md's code span: the span is fenced by more backticks than it holds.
+TEST(StudyTable, ABacktickInAChangeStaysInItsCodeSpan) {
+  StudyTable table;
+  for (const std::string& description : {std::string("uses `x` here"), std::string("``a``")}) {
+    StudyRow row;
+    row.name = "v";
+    row.set = {{"description", description}};
+    table.rows = {row};
+    const std::string md = study_markdown(study_json(table));
+    EXPECT_NE(md.find(description == "``a``" ? "| ``` description: ``a`` ``` |"
+                                             : "| ``description: uses `x` here`` |"),
+              std::string::npos)
+        << md;
+  }
 }
 
 TEST(Study, UnknownKeyOnThePathIsRefusedWithTheKeysThere) {
@@ -541,15 +619,46 @@ TEST(Study, PlacesAndRelativePathsFollowTheFileTheyWereWrittenIn) {
       << error;
 }
 
-// A whole number the study set is decimal in the variant and in the tables' record of the change: the
-// variant meshed 1,024 hexes for `target_hexes: 02000` (octal) and study.json said so.
+// A whole number the study set is decimal in the variant: it meshed 1,024 hexes for `target_hexes: 02000`
+// (octal). The tables record the change as written.
 TEST(Study, WholeNumbersTheStudySetAreDecimal) {
   std::string text = kStudy;
   text.replace(text.find("materials.default.E_MPa: 5500"), 29, "mesh.target_hexes: 02000");
   const Study study = load_study(study_folder(text) + "/study.yaml");
   ASSERT_EQ(study.variants.size(), 3u);
   EXPECT_EQ(study.variants[1].scenario.mesh.target_hexes, 2000);
-  EXPECT_EQ(study.variants[1].set.at("mesh.target_hexes"), 2000);
+  EXPECT_EQ(study.variants[1].set.at("mesh.target_hexes"), "02000");
+}
+
+// The record of a variant's changes retyped its values as YAML reads plain scalars: `name: 007` (the text
+// 007 in the run) was recorded as 7, `fixed: [x, y, z]` as ["x", true, "z"], `description: no` as false.
+// Every scalar is now its text as written; study.md writes lists and mappings as the study does.
+TEST(Study, TheChangesAreRecordedAsWritten) {
+  std::string text = kStudy;
+  text.replace(text.find("materials.default.E_MPa: 5500"), 29,
+               "name: 007\n      supports.base.fixed: [x, y, z]\n      description: no\n"
+               "      materials.default: {E_MPa: 5500}");
+  const std::string dir = study_folder(text);
+  const Study study = load_study(dir + "/study.yaml");
+  EXPECT_EQ(study.variants[1].scenario.name, "007");
+  EXPECT_EQ(study.variants[1].scenario.description, "no");
+  const json expected = json::parse(R"({"name": "007", "supports.base.fixed": ["x", "y", "z"],
+      "description": "no", "materials.default": {"E_MPa": "5500"}})");
+  EXPECT_EQ(json(study.variants[1].set), expected);
+  const test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/out"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(json::parse(test::read_file(dir + "/out/study.json"))["variants"][1]["set"], expected);
+  EXPECT_EQ(json::parse(test::read_file(dir + "/out/soft/results.json"))["study"]["set"], expected);
+  const std::string changes =
+      "name: 007; supports.base.fixed: [x, y, z]; description: no; materials.default: {E_MPa: 5500}";
+  EXPECT_NE(test::read_file(dir + "/out/study.md").find("| soft | `" + changes + "` |"), std::string::npos)
+      << test::read_file(dir + "/out/study.md");
+  EXPECT_NE(test::read_file(dir + "/out/study.csv").find("soft,\"" + changes + "\","), std::string::npos)
+      << test::read_file(dir + "/out/study.csv");
+  const test::CommandResult report =
+      test::run_hexbite({"-q", "report", dir + "/out/soft", "-o", dir + "/soft.html", "--no-pictures"});
+  ASSERT_EQ(report.exit_code, 0) << report.err;
+  EXPECT_NE(test::read_file(dir + "/soft.html").find("the scenario with " + changes), std::string::npos);
 }
 
 // All or nothing: a variant whose displacements are absurd (a modulus in the wrong unit) fails the study
@@ -580,6 +689,41 @@ TEST(Study, AFailedVariantLeavesTheOutputFolderAsItWas) {
   r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", dir + "/new/out"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_FALSE(fs::exists(dir + "/new")) << r.err;
+}
+
+// A variant that cannot be written (a file size limit) said "the run kept none of its files and did not
+// create 'out/reference'" of a folder that an earlier study had made, and that stayed; the study's own
+// clause says what became of the output folder.
+TEST(Study, AVariantThatCannotBeWrittenSaysOnlyWhatTheStudyDid) {
+  std::string first = kStudy;
+  first.erase(first.find("  - name: soft"));
+  const std::string dir = study_folder(first);
+  const std::string out = dir + "/out";
+  test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto before = test::files_under(out);
+  r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out},
+                        {"bash", "-c", "trap '' XFSZ; ulimit -f 20; exec \"$@\"", "bash"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(r.err.find("the run kept none of its files"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("did not create"), std::string::npos) << r.err;
+  EXPECT_NE(
+      r.err.find("/out/reference/mesh.vtu': the disk is full or the file passed a size limit (ulimit -f): "
+                 "make room on the disk or choose another output folder; the study kept none of its files "
+                 "and left '" +
+                 out + "' as it was"),
+      std::string::npos)
+      << r.err;
+  test::expect_same_files(before, test::files_under(out));
+}
+
+// A missing, empty or non-text base was told "write a word such as left_condyle", the hint for point names.
+TEST(Study, ABaseThatIsNoPathAsksForTheBaseScenariosFile) {
+  for (const char* base : {"base: \"\"", "base:", "base: [a]"}) {
+    std::string study = kStudy;
+    study.replace(study.find("base: base/cube.yaml"), 20, base);
+    expect_refused(study, 2, "give the base scenario's file path, e.g. base: ../lateral_bite_hard_nut.yaml");
+  }
 }
 
 // A study file named study.json (a JSON study is valid YAML), studied into its own folder, was replaced by
