@@ -5,11 +5,10 @@
 // atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
 // hexahedra and throw InputError naming the file and what is wrong: missing, unreadable, not a mesh of that
 // format, a cell that is not a hexahedron (with its index and type), no hexahedron at all, a NaN or infinite
-// coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes), a hexahedron
-// listed twice, two distinct vertices of hexes at exactly the same place (hexes that touch without sharing
-// their nodes; unused points may coincide). Orientation is not checked here: that is the quality module's
-// job (inverted hexes).
-// Cost: O(n log n) in the mesh size (the sorts that find copies).
+// coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes), a
+// hexahedron listed twice, two distinct vertices of hexes at exactly the same place (hexes that touch without
+// sharing their nodes; unused points may coincide). Orientation is not checked here: that is the quality
+// module's job (inverted hexes). Cost: O(n log n) in the mesh size (the sorts that find copies).
 #pragma once
 
 #include <cstdint>

@@ -661,21 +661,33 @@ TEST(Study, TheChangesAreRecordedAsWritten) {
   EXPECT_NE(test::read_file(dir + "/soft.html").find("the scenario with " + changes), std::string::npos);
 }
 
+// A study of the reference variant alone, run into DIR/out: the earlier study that a test then runs over.
+struct EarlierStudy {
+  std::string dir, out;
+  std::map<std::string, std::string> files;  // files_under(out) after it
+};
+EarlierStudy reference_study_in_out() {
+  std::string first = kStudy;
+  first.erase(first.find("  - name: soft"));
+  EarlierStudy earlier;
+  earlier.dir = study_folder(first);
+  earlier.out = earlier.dir + "/out";
+  const test::CommandResult r =
+      test::run_hexbite({"-q", "study", earlier.dir + "/study.yaml", "-o", earlier.out});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  earlier.files = test::files_under(earlier.out);
+  return earlier;
+}
+
 // All or nothing: a variant whose displacements are absurd (a modulus in the wrong unit) fails the study
 // after the others solved, and the folder keeps the earlier study's files byte for byte.
 TEST(Study, AFailedVariantLeavesTheOutputFolderAsItWas) {
-  std::string first = kStudy;
-  first.erase(first.find("  - name: soft"));
-  const std::string dir = study_folder(first);
-  const std::string out = dir + "/out";
-  test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto before = test::files_under(out);
+  const auto [dir, out, before] = reference_study_in_out();
   ASSERT_TRUE(before.count("reference/results.json"));
   ASSERT_TRUE(before.count("study.json"));
 
   test::write_file(dir + "/study.yaml", soft_setting("materials.default.E_MPa: 1.0e-6"));
-  r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
+  test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("small displacements; the results of variant 'soft' are meaningless"),
             std::string::npos)
@@ -695,14 +707,10 @@ TEST(Study, AFailedVariantLeavesTheOutputFolderAsItWas) {
 // create 'out/reference'" of a folder that an earlier study had made, and that stayed; the study's own
 // clause says what became of the output folder.
 TEST(Study, AVariantThatCannotBeWrittenSaysOnlyWhatTheStudyDid) {
-  std::string first = kStudy;
-  first.erase(first.find("  - name: soft"));
-  const std::string dir = study_folder(first);
-  const std::string out = dir + "/out";
-  test::CommandResult r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto before = test::files_under(out);
-  r = test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out},
+  const auto [dir, out, before] = reference_study_in_out();
+  ASSERT_FALSE(before.empty());
+  const test::CommandResult r =
+      test::run_hexbite({"-q", "study", dir + "/study.yaml", "-o", out},
                         {"bash", "-c", "trap '' XFSZ; ulimit -f 20; exec \"$@\"", "bash"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_EQ(r.err.find("the run kept none of its files"), std::string::npos) << r.err;
