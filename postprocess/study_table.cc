@@ -6,6 +6,8 @@
 #include <iterator>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "common/number_format.h"
 
 namespace hexbite {
@@ -103,29 +105,32 @@ std::string markdown_figure(const json& value, const json& change, bool compared
   return text;
 }
 
-// A value of `set` in YAML's flow style, as a study writes it: [x, y, z], {right: 0.8, left: 0.47}. Text
-// that YAML would read otherwise in a list or a mapping (a comma, a bracket, a quote, nothing) is quoted.
-std::string yaml_flow(const json& value) {
-  const auto dump = [](const json& v) { return v.dump(-1, ' ', false, json::error_handler_t::replace); };
+// `set`'s value as a YAML node: its text scalars (scenarios/study.cc records every scalar as written) as
+// text, null as null; a number of an older study.json as its JSON text.
+YAML::Node yaml_node(const json& value) {
   if (value.is_array()) {
-    std::string out;
-    for (const json& item : value) out += (out.empty() ? "" : ", ") + yaml_flow(item);
-    return "[" + out + "]";
+    YAML::Node node(YAML::NodeType::Sequence);
+    for (const json& item : value) node.push_back(yaml_node(item));
+    return node;
   }
   if (value.is_object()) {
-    std::string out;
-    for (const auto& [key, item] : value.items())
-      out += (out.empty() ? "" : ", ") + yaml_flow(json(key)) + ": " + yaml_flow(item);
-    return "{" + out + "}";
+    YAML::Node node(YAML::NodeType::Map);
+    for (const auto& [key, item] : value.items()) node[key] = yaml_node(item);
+    return node;
   }
-  if (!value.is_string()) return dump(value);
-  const std::string& text = value.get_ref<const std::string&>();
-  const bool plain = !text.empty() && text.find_first_of(",[]{}#\"'\n\r\t") == std::string::npos &&
-                     text.find(": ") == std::string::npos && text.back() != ':' && text.front() != ' ' &&
-                     text.back() != ' ' && std::string("&*!|>%@?").find(text.front()) == std::string::npos &&
-                     text.rfind("- ", 0) != 0 && text != "~" && text != "null" && text != "Null" &&
-                     text != "NULL";
-  return plain ? text : dump(value);
+  if (value.is_null()) return YAML::Node(YAML::NodeType::Null);
+  return YAML::Node(value.is_string() ? value.get<std::string>()
+                                      : value.dump(-1, ' ', false, json::error_handler_t::replace));
+}
+
+// A value of `set` in YAML's flow style, as a study writes it: [x, y, z], {right: 0.8, left: 0.47};
+// yaml-cpp's emitter quotes what YAML would read otherwise.
+std::string yaml_flow(const json& value) {
+  YAML::Emitter out;
+  out.SetSeqFormat(YAML::Flow);
+  out.SetMapFormat(YAML::Flow);
+  out << yaml_node(value);
+  return out.c_str();
 }
 
 }  // namespace
