@@ -186,8 +186,9 @@ void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surf
        << coarse.vertices[worst][0] << ", " << coarse.vertices[worst][1] << ", " << coarse.vertices[worst][2]
        << ") mm)";
   // A mesh of no bone's size is the one off in scale: --units cannot fix it, as it sets the surface's unit.
-  if (!mesh_size_warning(largest_extent(coarse.vertices)).empty())
-    text << "; the mesh is " << largest_extent(coarse.vertices)
+  const double extent = largest_extent(coarse.vertices);
+  if (!mesh_size_warning(extent).empty())
+    text << "; the mesh is " << extent
          << " mm across, no bone's size: hex mesh files are read in mm, so scale the mesh to millimetres "
             "where it was made (--units sets the unit of the surface only)";
   else
@@ -232,11 +233,7 @@ void run_refine(const RefineCliOptions& o) {
                                  [&](int h) {
                                    const int parent = h >> (3 * o.levels);
                                    return " (in input hex " + std::to_string(parent) +
-                                          (input.element_tags.empty()
-                                               ? std::string()
-                                               : ", Gmsh element " +
-                                                     std::to_string(input.element_tags[parent])) +
-                                          ")";
+                                          input.element_suffix(parent) + ")";
                                  }) +
                    "; no mesh written");
   }

@@ -208,13 +208,9 @@ void run_reorder(const ReorderOptions& o) {
   std::ostringstream out;
   out << "Reordered " << o.mesh << " (" << mesh.hexes.size() << " hexes, " << mesh.vertices.size()
       << " nodes) by "
-      << (o.method == "bfs"
-              ? "breadth-first order from " + start_text + " (input hex " + std::to_string(r.start_hex) +
-                    (input.element_tags.empty()
-                         ? std::string()
-                         : ", Gmsh element " + std::to_string(input.element_tags[r.start_hex])) +
-                    ")"
-              : std::string("reverse Cuthill-McKee"))
+      << (o.method == "bfs" ? "breadth-first order from " + start_text + " (input hex " +
+                                  std::to_string(r.start_hex) + input.element_suffix(r.start_hex) + ")"
+                            : std::string("reverse Cuthill-McKee"))
       << "\n\n";
   char line[128];
   std::snprintf(line, sizeof line, "%-34s %14s %14s\n", "nodal adjacency (nodes per hex)", "before", "after");

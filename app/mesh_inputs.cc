@@ -38,9 +38,13 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
   return in;
 }
 
+std::string HexMeshInput::element_suffix(int h) const {
+  return element_tags.empty() ? std::string() : ", Gmsh element " + std::to_string(element_tags[h]);
+}
+
 std::function<std::string(int)> HexMeshInput::hex_label() const {
   if (element_tags.empty()) return {};
-  return [this](int h) { return " (Gmsh element " + std::to_string(element_tags[h]) + ")"; };
+  return [this](int h) { return " (" + element_suffix(h).substr(2) + ")"; };
 }
 
 std::string mesh_size_warning(double largest_extent_mm) {

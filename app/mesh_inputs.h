@@ -35,6 +35,8 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
 struct HexMeshInput {
   HexMesh mesh;
   std::vector<long> element_tags;  // the Gmsh element tag of each hex of a .msh; empty for a .vtu
+  // ", Gmsh element 9" for hex h of a .msh, to follow its 0-based number inside brackets; empty for a .vtu.
+  std::string element_suffix(int h) const;
   // For hex_list_text(): " (Gmsh element 9)" after hex h's 0-based number, as Gmsh names the hex; an empty
   // function for a .vtu, whose hexes ParaView numbers 0-based as hexbite does. Valid while this lives.
   std::function<std::string(int)> hex_label() const;
