@@ -156,11 +156,11 @@ void add_quality_command(CLI::App& app) {
     if (options->json) {
       // The volume lets benchmarks compare a mesh with its surface (and peers' meshes with ours).
       nlohmann::json j = quality_to_json(summary, hex_mesh_volume(mesh));
-      if (list_worst) j["worst"] = worst_json(worst, input.element_tags);
+      if (list_worst) j["worst"] = worst_json(worst, input.gmsh.elements);
       std::cout << json_text(j) << '\n';
     } else if (!is_quiet()) {  // --quiet: like every other report, only the exit code tells
       std::cout << quality_table(options->mesh, summary, input.hex_label());
-      if (!worst.empty()) std::cout << worst_table(worst, input.element_tags);
+      if (!worst.empty()) std::cout << worst_table(worst, input.gmsh.elements);
     }
   });
 }

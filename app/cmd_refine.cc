@@ -158,8 +158,9 @@ nlohmann::json report_json(const RefineCliOptions& o, const RefineReport& r, boo
 // The mesh must be one made from the surface: its boundary nodes lie on it (up to the volume fit's offset,
 // a fraction of an edge). A mesh of another solid, or a surface in other units than --units says, would
 // otherwise be "refined" onto it, every new boundary node dragged tens of millimetres.
-void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surface,
+void require_mesh_on_surface(const HexMeshInput& input, const SurfaceProjector& surface,
                              const RefineCliOptions& o) {
+  const HexMesh& coarse = input.mesh;
   const HexBoundary boundary = extract_boundary(coarse);
   double edges = 0;
   long count = 0;
@@ -182,9 +183,9 @@ void require_mesh_on_surface(const HexMesh& coarse, const SurfaceProjector& surf
   text.precision(3);
   text << "'" << o.mesh << "' does not lie on '" << o.surface << "': " << far << " of "
        << boundary.boundary_vertices.size() << " boundary nodes are farther than half a mean boundary edge ("
-       << limit << " mm) from it, up to " << farthest << " mm (node " << worst << " at ("
-       << coarse.vertices[worst][0] << ", " << coarse.vertices[worst][1] << ", " << coarse.vertices[worst][2]
-       << ") mm)";
+       << limit << " mm) from it, up to " << farthest << " mm (node " << worst << input.node_suffix(worst)
+       << ", at (" << coarse.vertices[worst][0] << ", " << coarse.vertices[worst][1] << ", "
+       << coarse.vertices[worst][2] << ") mm)";
   // A mesh of no bone's size is the one off in scale: --units cannot fix it, as it sets the surface's unit.
   const double extent = largest_extent(coarse.vertices);
   if (!mesh_size_warning(extent).empty())
@@ -212,7 +213,7 @@ void run_refine(const RefineCliOptions& o) {
   std::unique_ptr<SurfaceProjector> projector;
   if (!o.surface.empty()) {
     projector = std::make_unique<SurfaceProjector>(load_surface_input(o.surface, o.units));
-    require_mesh_on_surface(coarse, *projector, o);
+    require_mesh_on_surface(input, *projector, o);
   }
 
   RefineOptions options;

@@ -39,11 +39,15 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
 }
 
 std::string HexMeshInput::element_suffix(int h) const {
-  return element_tags.empty() ? std::string() : ", Gmsh element " + std::to_string(element_tags[h]);
+  return gmsh.elements.empty() ? std::string() : ", Gmsh element " + std::to_string(gmsh.elements[h]);
+}
+
+std::string HexMeshInput::node_suffix(int v) const {
+  return gmsh.nodes.empty() ? std::string() : ", Gmsh node " + std::to_string(gmsh.nodes[v]);
 }
 
 std::function<std::string(int)> HexMeshInput::hex_label() const {
-  if (element_tags.empty()) return {};
+  if (gmsh.elements.empty()) return {};
   return [this](int h) { return " (" + element_suffix(h).substr(2) + ")"; };
 }
 
@@ -58,7 +62,7 @@ std::string mesh_size_warning(double largest_extent_mm) {
 HexMeshInput load_hex_mesh_input(const std::string& path, std::vector<MeshArray>* cell_arrays,
                                  std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
   HexMeshInput in;
-  in.mesh = read_hex_mesh(path, cell_arrays, point_arrays, not_read, &in.element_tags);
+  in.mesh = read_hex_mesh(path, cell_arrays, point_arrays, not_read, &in.gmsh);
   const std::string warning = mesh_size_warning(largest_extent(in.mesh.vertices));
   if (!warning.empty()) std::cerr << "hexbite: warning: '" << path << "': " << warning << '\n';
   return in;

@@ -34,9 +34,11 @@ MeshInputs load_mesh_inputs(const std::string& surface_file, const std::string& 
 // A hex mesh read by `quality`, `refine`, `reorder` or `quad from-mesh`.
 struct HexMeshInput {
   HexMesh mesh;
-  std::vector<long> element_tags;  // the Gmsh element tag of each hex of a .msh; empty for a .vtu
+  GmshTags gmsh;  // the Gmsh node and element tags of a .msh; empty for a .vtu
   // ", Gmsh element 9" for hex h of a .msh, to follow its 0-based number inside brackets; empty for a .vtu.
   std::string element_suffix(int h) const;
+  // ", Gmsh node 12" for node v of a .msh, the same way.
+  std::string node_suffix(int v) const;
   // For hex_list_text(): " (Gmsh element 9)" after hex h's 0-based number, as Gmsh names the hex; an empty
   // function for a .vtu, whose hexes ParaView numbers 0-based as hexbite does. Valid while this lives.
   std::function<std::string(int)> hex_label() const;

@@ -562,7 +562,7 @@ std::string gmsh_volume_element_name(int type) {
 
 }  // namespace
 
-HexMesh read_msh(const std::string& path, std::vector<long>* element_tags) {
+HexMesh read_msh(const std::string& path, GmshTags* tags) {
   check_readable(path, "Gmsh mesh");
   MshReader r(path);
   HexMesh mesh;
@@ -725,7 +725,7 @@ HexMesh read_msh(const std::string& path, std::vector<long>* element_tags) {
   if (!have_format) r.fail("no $MeshFormat section: not a Gmsh .msh file");
   if (!have_elements) r.fail("no $Elements section");
   check_mesh(mesh, "Gmsh mesh '" + path + "'", node_tags);
-  if (element_tags != nullptr) *element_tags = std::move(hex_tags);
+  if (tags != nullptr) *tags = {std::move(node_tags), std::move(hex_tags)};
   return mesh;
 }
 
@@ -746,15 +746,15 @@ void write_hex_mesh(const std::string& path, const HexMesh& mesh, const std::vec
 
 HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays,
                       std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read,
-                      std::vector<long>* element_tags) {
+                      GmshTags* tags) {
   if (lower_extension(path) != ".msh") {
-    if (element_tags) element_tags->clear();
+    if (tags) *tags = {};
     return read_vtu(path, cell_arrays, point_arrays, not_read);
   }
   if (cell_arrays) cell_arrays->clear();
   if (point_arrays) point_arrays->clear();
   if (not_read) not_read->clear();
-  return read_msh(path, element_tags);
+  return read_msh(path, tags);
 }
 
 }  // namespace hexbite

@@ -76,11 +76,18 @@ std::string format_inp_number(double v);
 // Gmsh's node order, which equals VTK's) tagged 1..m.
 void write_msh(const std::string& path, const HexMesh& mesh);
 
+// The tags a .msh file gives its nodes and hexes, in the order of HexMesh::vertices and HexMesh::hexes,
+// for messages that name a node or a hex as Gmsh does (hexbite numbers them from 0 in file order).
+struct GmshTags {
+  std::vector<long> nodes;
+  std::vector<long> elements;
+};
+
 // Reads a Gmsh ASCII .msh file, format 4.1 or 2.2 (its nodes in $Nodes, or in 2.2 $ParametricNodes).
 // Points, lines and faces are skipped; hexahedra (type 5) are kept; any other volume element is an
-// InputError. All nodes are kept, in the file's order. When given, `element_tags` receives the file's
-// element tag of each hex, for messages that name a hex as Gmsh does.
-HexMesh read_msh(const std::string& path, std::vector<long>* element_tags = nullptr);
+// InputError. All nodes are kept, in the file's order. When given, `tags` receives the file's node and
+// element tags.
+HexMesh read_msh(const std::string& path, GmshTags* tags = nullptr);
 
 // The hex mesh formats by the file name's extension (any case): .vtu (write_vtu, with the arrays), .inp
 // (write_inp, nodes and C3D8 elements only) or .msh (write_msh); the arrays go only into a .vtu. Throws
@@ -90,11 +97,10 @@ void write_hex_mesh(const std::string& path, const HexMesh& mesh,
                     const std::vector<MeshArray>& point_arrays = {});
 
 // Reads a .msh file (read_msh) by its extension (any case), any other name as a .vtu (read_vtu, which names
-// a file that is not one); the arrays come only from a .vtu (a .msh leaves them empty), the element tags
+// a file that is not one); the arrays come only from a .vtu (a .msh leaves them empty), the Gmsh tags
 // only from a .msh (a .vtu leaves them empty).
 HexMesh read_hex_mesh(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
                       std::vector<MeshArray>* point_arrays = nullptr,
-                      std::vector<std::string>* not_read = nullptr,
-                      std::vector<long>* element_tags = nullptr);
+                      std::vector<std::string>* not_read = nullptr, GmshTags* tags = nullptr);
 
 }  // namespace hexbite

@@ -286,7 +286,21 @@ TEST_F(BallRefine, CommandRefusesASurfaceTheMeshDoesNotLieOn) {
     EXPECT_NE(r.err.find("'" + dir + "/coarse.vtu' does not lie on"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("give the surface the mesh was made from"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir + "/fine.vtu"));
+    EXPECT_EQ(r.err.find("Gmsh node"), std::string::npos) << r.err;
   }
+  // A .msh names the farthest node by its Gmsh tag too (write_msh tags the nodes 1..n), as Gmsh shows it.
+  write_msh(dir + "/coarse.msh", coarse);
+  const auto r =
+      run_hexbite({"refine", dir + "/coarse.msh", "--surface", dir + "/big.stl", "-o", dir + "/fine.msh"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  const std::size_t at = r.err.find(" mm (node ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const int node = std::stoi(r.err.substr(at + 10));
+  EXPECT_NE(
+      r.err.find("(node " + std::to_string(node) + ", Gmsh node " + std::to_string(node + 1) + ", at ("),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/fine.msh"));
 }
 
 TEST(HexRefineCommand, BadInput) {
