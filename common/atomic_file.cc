@@ -80,8 +80,14 @@ void write_atomically(const std::string& final_path, const std::function<void(co
   if (ec) {
     std::error_code ignored;  // not ec: a remove that finds nothing clears it ("cannot write ...: Success")
     fs::remove(tmp, ignored);
-    throw RunError("cannot write '" + final_path + "': " + ec.message());
+    throw RunError(replace_refused(final_path, ec));
   }
+}
+
+std::string replace_refused(const std::string& path, const std::error_code& ec) {
+  return "cannot write '" + path + "': " + ec.message() +
+         " (the finished file could not take its place: an immutable file, which lsattr marks 'i' and "
+         "chattr -i frees, or a read-only mount refuse it); free the file or choose another output name";
 }
 
 std::string temporary_path_beside(const std::string& final_path, const std::string& extension) {

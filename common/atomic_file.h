@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <string>
+#include <system_error>
 
 namespace hexbite {
 
@@ -40,6 +41,10 @@ std::string temporary_path_beside(const std::string& final_path, const std::stri
 // Why a write failed when the stream says only that it failed, and what to do.
 inline constexpr const char* kWriteFailed = "the disk is full or the file passed a size limit (ulimit -f)";
 inline constexpr const char* kWriteAdvice = "make room on the disk or choose another output folder";
+
+// The message for a finished output that could not take the place of `path` (the rename failed with `ec`):
+// an immutable file (chattr +i) gave only the system's "Operation not permitted".
+std::string replace_refused(const std::string& path, const std::error_code& ec);
 
 // Convenience: writes a whole text or binary string atomically.
 void write_file_atomically(const std::string& final_path, const std::string& contents);

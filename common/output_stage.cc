@@ -12,6 +12,7 @@
 #include <iostream>
 #include <set>
 
+#include "common/atomic_file.h"
 #include "common/error.h"
 
 namespace hexbite {
@@ -141,7 +142,7 @@ void OutputStage::commit(const std::vector<std::string>& files,
     std::error_code ec;
     fs::create_directories(to.parent_path(), ec);  // inside the stage's .previous: removed with the stage
     fs::rename(from, to, ec);
-    if (ec) throw RunError("cannot write '" + named.string() + "': " + ec.message());
+    if (ec) throw RunError(replace_refused(named.string(), ec));
     done.push_back({from, to});
   };
   // The folders of the output folder that the files go into ("" for the output folder itself).

@@ -69,6 +69,23 @@ TEST(AtomicFile, ASignalRemovesARegisteredFolderWithItsFiles) {
   EXPECT_TRUE(fs::is_empty(dir)) << "the folder or a picture was left";
 }
 
+// A finished file that cannot take the output's place (an immutable file, chattr +i, refuses the rename;
+// here a folder of that name, which the commands refuse earlier) gave only the system's text: the message
+// says what refused it and what to do, and no temporary file stays.
+TEST(AtomicFile, AReplaceThatIsRefusedSaysWhatToDo) {
+  const std::string dir = test::temp_dir();
+  fs::create_directories(dir + "/out.vtu/inside");
+  const std::string msg =
+      test::message_of<RunError>([&] { write_file_atomically(dir + "/out.vtu", "a mesh"); });
+  EXPECT_EQ(msg.rfind("cannot write '" + dir + "/out.vtu': ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("the finished file could not take its place: an immutable file, which lsattr marks 'i' "
+                     "and chattr -i frees, or a read-only mount refuse it); free the file or choose another "
+                     "output name"),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+}
+
 TEST(OutputStage, CommitMovesTheSetInAndRemovesTheEarlierRunsOtherOutputs) {
   const std::string dir = test::temp_dir();
   test::write_file(dir + "/out_a", "old a\n");
