@@ -643,6 +643,11 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
     errors.watch(writer);
     writer->SetInputData(image);
     writer->SetQFormMatrix(qform);
+    // The header states millimetres: with xyzt_units 0 (VTK's default) other tools, and hexbite's own
+    // reader, have to guess the unit.
+    auto header = vtkSmartPointer<vtkNIFTIImageHeader>::New();
+    header->SetXYZTUnits(vtkNIFTIImageHeader::UnitsMM);
+    writer->SetNIFTIHeader(header);
     writer->SetFileName(tmp.c_str());
     writer->Write();
   }
@@ -659,8 +664,9 @@ void write_volume(const std::string& path, const VoxelVolume& volume) {
   }
   fs::rename(tmp, target, ec);
   if (ec) {
-    fs::remove(tmp, ec);
-    throw RunError("cannot write volume '" + path + "': " + ec.message());
+    std::error_code ignored;  // not ec, which a successful remove clears
+    fs::remove(tmp, ignored);
+    throw RunError(replace_refused(path, ec));
   }
 }
 

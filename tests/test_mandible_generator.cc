@@ -525,7 +525,11 @@ TEST(CtVolume, WritesAndReadsMetaImageAndNifti) {
     SCOPED_TRACE(name);
     const std::string path = test::temp_dir() + "/" + name;
     write_volume(path, ct);
-    const VoxelVolume back = read_volume(path);
+    VolumeInfo info;
+    const VoxelVolume back = read_volume(path, &info);
+    // A NIfTI states millimetres (it said no unit, xyzt_units 0, and other tools had to guess); a
+    // MetaImage has no field for it.
+    EXPECT_EQ(info.length_unit, std::string(name).find(".nii") != std::string::npos ? "mm" : "") << name;
     EXPECT_EQ(back.dims, ct.dims);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(back.origin[k], ct.origin[k], 1e-4);

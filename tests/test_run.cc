@@ -818,6 +818,14 @@ TEST(RunScenario, CtVolumeInAnImplausibleUnitIsWarnedOfAndUnitsReadsIt) {
       run_box(dir, "in_cm", "ct: {file: box.mha, threshold: 500, units: cm}", 10.0);
   EXPECT_EQ(in_cm.exit_code, 0) << in_cm.err;
   EXPECT_EQ(in_cm.err.find("warning"), std::string::npos) << in_cm.err;
+  // A NIfTI states its unit (write_volume writes mm); units: cm in the scenario holds over it.
+  write_volume(dir + "/box.nii", box);
+  const test::CommandResult nifti_mm = run_box(dir, "nifti_mm", "ct: {file: box.nii, threshold: 500}", 1.0);
+  EXPECT_NE(nifti_mm.err.find("box.nii: the surface is 10 mm across"), std::string::npos) << nifti_mm.err;
+  const test::CommandResult nifti_cm =
+      run_box(dir, "nifti_cm", "ct: {file: box.nii, threshold: 500, units: cm}", 10.0);
+  EXPECT_EQ(nifti_cm.exit_code, 0) << nifti_cm.err;
+  EXPECT_EQ(nifti_cm.err.find("warning"), std::string::npos) << nifti_cm.err;
 }
 
 // Support names that differ only in case or punctuation give one CalculiX set name: the export failed
