@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -161,12 +162,29 @@ std::optional<std::string> missing_command_message(const CLI::App& app, bool mis
 }
 
 // A file whose name starts with '-' (`hexbite quality -m.vtu`) is read as an option, and CLI11 then says
-// only that the file's argument is required: the message names the file and how to give it. nullopt when
-// no word left over is an existing file.
-std::optional<std::string> file_read_as_option_message(const CLI::App& app) {
-  for (const std::string& word : app.remaining(true)) {
+// only that the file's argument is required, or worse, splits it (`mesh -old.stl`: option -o with the
+// value 'ld.stl', "this command writes .vtu ..."): the message names the file and how to give it. The words
+// of the command line are looked at, not what CLI11 left over; a word that is the value of the option
+// before it (`-o -x.vtu`, an output to replace) or comes after '--' is no such file. nullopt when no word
+// is one.
+std::optional<std::string> file_read_as_option_message(const CLI::App& app, int argc, char** argv) {
+  // The option `name` of the command line's commands, when it takes a value.
+  auto takes_value = [&](const std::string& name) {
+    for (const CLI::App* level = &app; level != nullptr;) {
+      if (const CLI::Option* option = level->get_option_no_throw(name)) return option->get_type_size() != 0;
+      const std::vector<const CLI::App*> given = level->get_subcommands({});
+      const auto used =
+          std::find_if(given.begin(), given.end(), [](const CLI::App* a) { return a->parsed(); });
+      level = used == given.end() ? nullptr : *used;
+    }
+    return false;
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--") break;
     std::error_code ec;
-    if (word.size() > 1 && word[0] == '-' && std::filesystem::exists(word, ec))
+    if (word.size() > 1 && word[0] == '-' && std::filesystem::exists(word, ec) &&
+        !(i > 1 && argv[i - 1][0] == '-' && takes_value(argv[i - 1])))
       return "'" + word + "' was read as an option, but it is a file: give it as './" + word +
              "', or put '--' before it (no option after '--' is read as one)";
   }
@@ -239,6 +257,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return checked_stdout(app.exit(e));
   } catch (const CLI::ArgumentMismatch& e) {
+    if (const std::optional<std::string> file = file_read_as_option_message(app, argc, argv))
+      return report("hexbite: error: " + *file + '\n', hexbite::kExitBadInput, errors);
     std::ostringstream text;
     const std::optional<std::string> repeated = repeated_option_message(app);
     // The message (which option was given twice, when that is the mismatch) and a hint to --help.
@@ -247,13 +267,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::RequiredError& e) {
     if (const std::optional<std::string> missing = missing_command_message(app))
       return report("hexbite: error: " + *missing + '\n', hexbite::kExitBadInput, errors);
-    if (const std::optional<std::string> file = file_read_as_option_message(app))
+    if (const std::optional<std::string> file = file_read_as_option_message(app, argc, argv))
       return report("hexbite: error: " + *file + '\n', hexbite::kExitBadInput, errors);
     std::ostringstream text;
     app.exit(e, text, text);
     return report(text.str(), hexbite::kExitBadInput, errors);
   } catch (const CLI::ParseError& e) {
-    if (const std::optional<std::string> file = file_read_as_option_message(app))
+    if (const std::optional<std::string> file = file_read_as_option_message(app, argc, argv))
       return report("hexbite: error: " + *file + '\n', hexbite::kExitBadInput, errors);
     std::ostringstream text;
     app.exit(e, text, text);  // the message and a hint to --help

@@ -785,6 +785,26 @@ TEST(CliBadInput, AFileNamedLikeAnOptionIsNamed) {
   r = run_hexbite({"quality", "-n.vtu"}, in_dir);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(r.err.find("was read as an option"), std::string::npos) << r.err;
+  // A name that starts like a short option of the command was split into it (helper U): `refine
+  // -out.vtu -o f.vtu` read -o 'ut.vtu' and said "-o,--output was given 2 times"; `surface check -old.stl`
+  // said "FILE is required"; `mesh -old.stl -o m.vtu` said "--output: 'ld.stl': this command writes ...".
+  write_file(dir + "/-out.vtu", "x");
+  write_file(dir + "/-old.stl", "x");
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"refine", "-out.vtu", "-o", "f.vtu"},
+                                               std::vector<std::string>{"surface", "check", "-old.stl"},
+                                               std::vector<std::string>{"mesh", "-old.stl", "-o", "m.vtu"}}) {
+    r = run_hexbite(args, in_dir);
+    EXPECT_EQ(r.exit_code, 2) << args[0] << ": " << r.err;
+    EXPECT_NE(
+        r.err.find("'" + args[args[0] == "surface" ? 2 : 1] + "' was read as an option, but it is a file"),
+        std::string::npos)
+        << args[0] << ": " << r.err;
+  }
+  // The value of an option that takes one is no such file: the unknown option is what is wrong.
+  r = run_hexbite({"mesh", "./-old.stl", "-o", "-out.vtu", "--bogus"}, in_dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--bogus"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("was read as an option"), std::string::npos) << r.err;
 }
 
 // Inputs that are no regular file: a named pipe or /dev/zero was read without end (the memory grew by
