@@ -3,6 +3,7 @@
 // `mpirun -np N hexbite run ...` works; without mpirun the program is a single rank.
 #include <mpi.h>
 
+#include <pwd.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -49,6 +50,22 @@ bool command_uses_solver(int argc, char** argv) {
     }
   }
   return solver;
+}
+
+// What Open MPI needs of the environment, set before MPI starts. Its daemon (which MPI_Init starts without
+// mpirun) resolves a relative TMPDIR from '/', and printed "Impossible to open the file
+// /t/ompi.../contact.txt" with an ORTE error on a run that succeeded: TMPDIR is made absolute. With HOME
+// unset, a uid without a passwd entry (a container run under an arbitrary uid) crashed PMIx in MPI_Init
+// (pmix_home_directory reads getpwuid's null): HOME is set to '/', not to a shared folder such as /tmp, where
+// anyone could place a .petscrc or .openmpi/mca-params.conf that PETSc or Open MPI would read.
+void prepare_mpi_environment() {
+  const char* tmpdir = std::getenv("TMPDIR");
+  if (tmpdir && *tmpdir && tmpdir[0] != '/') {
+    std::error_code ec;
+    const std::filesystem::path absolute = std::filesystem::absolute(tmpdir, ec);
+    if (!ec) setenv("TMPDIR", absolute.c_str(), 1);
+  }
+  if (std::getenv("HOME") == nullptr && getpwuid(getuid()) == nullptr) setenv("HOME", "/", 1);
 }
 
 // Open MPI keeps its session files under TMPDIR: one where no folder can be made ended MPI_Init with a
@@ -213,12 +230,17 @@ int main(int argc, char** argv) {
   hexbite::remove_temporary_files_on_signals();
   std::optional<hexbite::MpiSession> mpi;
   if (command_uses_solver(argc, argv)) {
+    prepare_mpi_environment();
     if (const std::string problem = unusable_tmpdir(); !problem.empty()) {
       std::cerr << problem;
       return hexbite::kExitBadInput;
     }
     mpi.emplace(argc, argv);
   }
+  // A reader that closes standard output early (`hexbite quality m.vtu | head -1`) killed the process with
+  // SIGPIPE: exit 141 and no word. Ignored, the write fails with EPIPE, and checked_stdout says so (exit 1).
+  // Set after MPI starts, which restores the default action.
+  std::signal(SIGPIPE, SIG_IGN);
   // Only rank 0 reports progress and results; an error met by every rank alike is reported once (report).
   const bool root = hexbite::MpiSession::rank() == 0;
   MPI_Comm errors = MPI_COMM_NULL;

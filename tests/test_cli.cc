@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include <pwd.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "tests/test_util.h"
 
@@ -435,6 +437,51 @@ TEST(Cli, RunAndStudyStartUnderAFileSizeLimitAndNameAnUnusableTmpdir) {
             "MPI keeps its session files: point TMPDIR at a folder you can write to\n");
 }
 
+// A relative TMPDIR passed hexbite's own check, but MPI's helper process read it from '/': a run printed
+// "Impossible to open the file /t/ompi.../contact.txt" and an ORTE error, even under -q. It is taken from
+// the current folder now, and only hexbite's own message is printed.
+TEST(Cli, RunAndStudyTakeARelativeTmpdirFromTheCurrentFolder) {
+  const std::string dir = temp_dir();
+  fs::create_directories(dir + "/t");
+  for (const char* command : {"run", "study"}) {
+    const test::CommandResult r = run_hexbite({"-q", command, "none.yaml", "-o", "out"},
+                                              {"bash", "-c", "cd \"$0\" && TMPDIR=t exec \"$@\"", dir});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("hexbite: error: ", 0), 0u) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than hexbite's own line:\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
+// With HOME unset, a user id without a passwd entry (a container run under an arbitrary uid) crashed Open
+// MPI as it started: a segmentation fault in pmix_home_directory, a page of its text, exit 1. Taking on such
+// a uid needs root (setpriv).
+TEST(Cli, RunAndStudyStartWithoutHomeUnderAUidWithoutAPasswdEntry) {
+  const std::string uid = "12345";
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to run as a uid without a passwd entry";
+  if (getpwuid(std::stoi(uid)) != nullptr) GTEST_SKIP() << "uid " << uid << " has a passwd entry here";
+  // A folder that uid can write to, for TMPDIR and the files (the tests' own folders are root's alone).
+  std::string tmp = (fs::temp_directory_path() / "hexbite-uid-XXXXXX").string();
+  ASSERT_NE(mkdtemp(tmp.data()), nullptr);
+  fs::permissions(tmp, fs::perms::all);
+  const std::vector<std::string> as_stranger = {
+      "setpriv", "--reuid=" + uid, "--regid=" + uid, "--clear-groups", "env", "-u", "HOME", "TMPDIR=" + tmp};
+  if (run_hexbite({"--version"}, as_stranger).exit_code != 0) {  // --version starts no MPI
+    fs::remove_all(tmp);
+    GTEST_SKIP() << "no setpriv, or the program is out of reach of uid " << uid;
+  }
+  for (const auto& [command, file] :
+       std::vector<std::pair<std::string, std::string>>{{"run", "scenario"}, {"study", "study"}}) {
+    const test::CommandResult r =
+        run_hexbite({"-q", command, tmp + "/none.yaml", "-o", tmp + "/out"}, as_stranger);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(r.err, "hexbite: error: " + file + " file '" + tmp +
+                         "/none.yaml' does not exist: check the path and the spelling\n");
+  }
+  std::error_code ec;  // MPI's helper may still be removing its session folder
+  fs::remove_all(tmp, ec);
+}
+
 // Level counts are counts like --target-hexes: `--levels 1.0` was "not in range 0 to 3", an empty value too,
 // and `--levels 0x1` ran one level. Hexadecimal is refused for every count.
 TEST(CliBadInput, LevelCountsAreWholeDecimalNumbers) {
@@ -571,6 +618,22 @@ TEST(Cli, QuietLeavesStandardOutputEmpty) {
     EXPECT_EQ(r.exit_code, 0) << args[1] << "\n" << r.err;
     EXPECT_TRUE(r.out.empty()) << args[1] << " printed under --quiet:\n" << r.out.substr(0, 400);
   }
+}
+
+// A reader that closed standard output early (`| head -1`) killed the program with SIGPIPE: exit 141 and
+// no word. The write fails now, and the program says so, as for a full disk behind `> file`.
+TEST(Cli, StandardOutputClosedByItsReaderIsAFailedRunThatSaysSo) {
+  const std::string dir = temp_dir();
+  const std::string hex = dir + "/cube.msh";
+  write_file(hex, kCubeMsh);
+  // The program starts when the reader (true) has gone.
+  const test::CommandResult r = run_hexbite(
+      {"quality", hex}, {"bash", "-c", "{ sleep 1; exec \"$@\"; } | true; exit ${PIPESTATUS[0]}", "bash"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(
+      r.err.find("hexbite: failed: cannot write to standard output (a full disk, or the output closed)"),
+      std::string::npos)
+      << r.err;
 }
 
 // On a terminal, a step that failed drew its progress bar at 100 % right above the error ("surface check

@@ -431,6 +431,24 @@ TEST(RunScenario, CalculixAgreesOnTheExportedModel) {
   EXPECT_GT(bite, 100.0);
 }
 
+// A reader that closed standard output early (`| head -1`) killed a run with SIGPIPE (exit 141, no word). The
+// run goes on and writes its folder, then says that what it printed was lost (exit 1).
+TEST(RunScenario, ARunWhoseStandardOutputIsClosedWritesItsFolderAndSaysSo) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  test::write_file(dir + "/cube.yaml", cube_on_a_floor("[0, 0, -1]", ""));
+  // The run starts when the reader (true) has gone.
+  const test::CommandResult r =
+      test::run_hexbite({"run", dir + "/cube.yaml", "-o", dir + "/out"},
+                        {"bash", "-c", "{ sleep 1; exec \"$@\"; } | true; exit ${PIPESTATUS[0]}", "bash"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(
+      r.err.find("hexbite: failed: cannot write to standard output (a full disk, or the output closed)"),
+      std::string::npos)
+      << r.err;
+  EXPECT_TRUE(json::parse(test::read_file(dir + "/out/results.json"))["checks"]["passed"].get<bool>());
+}
+
 std::string write_scenario(const std::string& text) {
   const std::string path = test::temp_dir() + "/bad.yaml";
   test::write_file(path, text);
