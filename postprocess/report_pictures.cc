@@ -22,23 +22,27 @@ namespace hexbite {
 
 namespace {
 
+// What to do when the pictures cannot be drawn under TMPDIR.
+constexpr const char* kTmpdirAdvice = "point TMPDIR at a folder you can write to, or give --no-pictures";
+
 // A fresh folder under the system's temporary folder, removed with everything in it when this goes.
 class TemporaryFolder {
  public:
   TemporaryFolder() {
     // TMPDIR naming a missing folder or a file gave the library's own text ("filesystem error:
-    // temp_directory_path: No such file or directory").
+    // temp_directory_path: No such file or directory"). Bad input (exit 2), as for run and study, which
+    // refuse such a TMPDIR before MPI starts.
     std::error_code ec;
     const std::filesystem::path base = std::filesystem::temp_directory_path(ec);
     const char* tmpdir = std::getenv("TMPDIR");
-    const std::string fix = "; point TMPDIR at a folder you can write to, or give --no-pictures";
     if (ec)
-      throw RunError("cannot make a temporary folder for the report's pictures: TMPDIR is '" +
-                     std::string(tmpdir ? tmpdir : "") + "' (" + ec.message() + ")" + fix);
+      throw InputError("cannot make a temporary folder for the report's pictures: TMPDIR is '" +
+                       std::string(tmpdir ? tmpdir : "") + "' (" + ec.message() + "); " + kTmpdirAdvice);
     std::string name = (base / "hexbite-report-XXXXXX").string();
     if (mkdtemp(name.data()) == nullptr)
-      throw RunError("cannot make a temporary folder for the report's pictures in '" + base.string() + "' (" +
-                     std::strerror(errno) + ")" + fix);
+      throw InputError("cannot make a temporary folder for the report's pictures in '" + base.string() +
+                       "' (" + std::strerror(errno) + "); " + kTmpdirAdvice);
+    place_ = (tmpdir && *tmpdir ? "TMPDIR '" : "'") + base.string() + "'";
     path_ = name;
     // Ctrl-C or SIGTERM during the rendering left the folder and its pictures behind (helper P).
     guards_.push_back(std::make_unique<RemovedOnSignal>(path_, RemovedOnSignal::kFolder));
@@ -55,8 +59,11 @@ class TemporaryFolder {
     guards_.push_back(std::make_unique<RemovedOnSignal>(path));
     return path;
   }
+  // The folder it was made in, for messages: "TMPDIR '/scratch'", or "'/tmp'".
+  const std::string& place() const { return place_; }
 
  private:
+  std::string place_;
   std::string path_;
   std::vector<std::unique_ptr<RemovedOnSignal>> guards_;
 };
@@ -121,7 +128,16 @@ std::vector<ReportPicture> render_report_pictures(const std::string& solution_vt
     options.height = 800;
     options.colour_max = s.colour_max;
     const std::string png = folder.file(s.field + "_" + s.view + ".png");
-    const RenderedMesh drawn = render_mesh_png(solution_vtu, s.field, png, options);
+    RenderedMesh drawn;
+    try {
+      drawn = render_mesh_png(solution_vtu, s.field, png, options);
+    } catch (const RunError& e) {
+      // The writer's advice ("make room on the disk or choose another output folder") blamed the report's
+      // folder for a full TMPDIR, where the picture is drawn.
+      if (std::string(e.what()).find(kWriteFailed) == std::string::npos) throw;
+      throw RunError("cannot draw the report's pictures in " + folder.place() + ": " + kWriteFailed +
+                     "; make room there, point TMPDIR at another folder, or give --no-pictures");
+    }
     check_same_run(solution_vtu, drawn, s.field, l);
     pictures.push_back({s.field, s.view, s.caption, read_bytes(png)});
   }

@@ -216,17 +216,47 @@ TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
   EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
 
   // TMPDIR naming a file gave the library's own text ("filesystem error: temp_directory_path: Not a
-  // directory"); now it is named, with what to do (helper K).
+  // directory"); now it is named, with what to do (helper K). Bad input (exit 2) as for run and study, not
+  // a failed run (exit 1), and so is a TMPDIR where no folder can be made.
   launcher = display_launcher();
   launcher.insert(launcher.end(), {"env", "TMPDIR=" + dir + "/r.htm"});
-  const test::CommandResult bad = run_hexbite({"report", *run_dir_, "-o", dir + "/bad.html"}, launcher);
-  EXPECT_EQ(bad.exit_code, 1) << bad.err;
-  EXPECT_NE(bad.err.find("cannot make a temporary folder for the report's pictures: TMPDIR is '" + dir +
-                         "/r.htm' (Not a directory); point TMPDIR at a folder you can write to, or give "
-                         "--no-pictures"),
-            std::string::npos)
+  test::CommandResult bad = run_hexbite({"report", *run_dir_, "-o", dir + "/bad.html"}, launcher);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(
+      bad.err.find("hexbite: error: cannot make a temporary folder for the report's pictures: TMPDIR is '" +
+                   dir +
+                   "/r.htm' (Not a directory); point TMPDIR at a folder you can write to, or give "
+                   "--no-pictures"),
+      std::string::npos)
+      << bad.err;
+  launcher = display_launcher();
+  launcher.insert(launcher.end(), {"env", "TMPDIR=/proc"});
+  bad = run_hexbite({"report", *run_dir_, "-o", dir + "/bad.html"}, launcher);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(
+      bad.err.find("hexbite: error: cannot make a temporary folder for the report's pictures in '/proc'"),
+      std::string::npos)
       << bad.err;
   EXPECT_FALSE(fs::exists(dir + "/bad.html"));
+}
+
+// A TMPDIR that filled up while the pictures were drawn there was blamed on the report's folder ("make room
+// on the disk or choose another output folder"). A file size limit fails the pictures' writes as a full disk
+// does.
+TEST_F(Report, AFullTmpdirIsNamedWithTheWayAroundIt) {
+  const std::string dir = temp_dir(), tmp = dir + "/tmp";
+  fs::create_directories(tmp);
+  std::vector<std::string> launcher = display_launcher();
+  launcher.insert(launcher.end(),
+                  {"env", "TMPDIR=" + tmp, "bash", "-c", "trap '' XFSZ; ulimit -f 20; exec \"$@\"", "bash"});
+  const test::CommandResult r = run_hexbite({"-q", "report", *run_dir_, "-o", dir + "/r.html"}, launcher);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(r.err,
+            "hexbite: failed: cannot draw the report's pictures in TMPDIR '" + tmp +
+                "': the disk is full or the file passed a size limit (ulimit -f); make room there, point "
+                "TMPDIR at another folder, or give --no-pictures\n");
+  EXPECT_FALSE(fs::exists(dir + "/r.html"));
+  EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
 }
 
 // Supports that leave a rotation to the extent of their patches (as in tests/test_run.cc, on the cube): a
