@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -36,6 +37,8 @@
 namespace hexbite {
 
 namespace {
+
+namespace fs = std::filesystem;
 
 struct StudyCliOptions {
   std::string study;
@@ -111,6 +114,18 @@ void run_study(const StudyCliOptions& o) {
       return folders.count(name.substr(0, slash)) > 0 && name.find('/', slash + 1) == std::string::npos &&
              is_run_output_name(name.substr(slash + 1));
     });
+  }
+  // A file where a variant's folder goes (a variant named notes.txt beside your notes) was found only when
+  // the study was moved into DIR, after every variant had solved. The rule of the stage's commit: anything
+  // but a folder is in the way, a link too.
+  for (const StudyVariant& v : study.variants) {
+    const fs::path folder = fs::path(o.output) / v.name;
+    std::error_code ec;
+    const fs::file_status status = fs::symlink_status(folder, ec);
+    if (fs::exists(status) && !fs::is_directory(status))
+      throw InputError(v.where.str() + ": variant '" + v.name + "': its run folder '" + folder.string() +
+                       "' is a file, not a folder; rename the variant (its name names the folder), remove or "
+                       "rename the file, or choose another output folder");
   }
   const auto counted = [&](std::size_t i) {
     return std::to_string(i + 1) + " / " + std::to_string(count) + ": " + study.variants[i].name;

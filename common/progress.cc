@@ -42,7 +42,9 @@ void set_json_output(bool json) {
 
 void info(const std::string& line) {
   if (is_quiet()) return;
-  (g_json ? std::cerr : std::cout) << line << '\n';
+  // Flushed: into a file or a pipe, a study's "check variant ..." lines waited in the buffer until the end
+  // of the command, and a kill (a batch system's time limit) lost them.
+  (g_json ? std::cerr : std::cout) << line << '\n' << std::flush;
 }
 
 Progress::Progress(std::string label)

@@ -31,7 +31,8 @@ class QuietThread {
 // carries that document alone, and info() lines go to standard error.
 void set_json_output(bool json);
 
-// Prints an informational line unless quiet: to stdout, or to stderr under set_json_output(true).
+// Prints an informational line unless quiet: to stdout, or to stderr under set_json_output(true); flushed at
+// once, so that a file or a pipe has it while the command works.
 void info(const std::string& line);
 
 // A progress bar for one named step. On a terminal (stderr is a TTY) it redraws

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -723,6 +724,50 @@ TEST(Study, AVariantThatCannotBeWrittenSaysOnlyWhatTheStudyDid) {
       std::string::npos)
       << r.err;
   test::expect_same_files(before, test::files_under(out));
+}
+
+// A variant whose folder would replace a file in DIR (a variant named notes.txt beside your notes, or named
+// after the base scenario studied into its own folder) was found only when the study was moved into DIR,
+// after every variant had solved (exit 1). It is refused at the variant's line before anything is checked
+// further, and the file stays.
+TEST(Study, AFileWhereAVariantsFolderGoesIsRefusedAtTheVariantsLine) {
+  for (const std::string& name : {"notes.txt", "cube.yaml"}) {
+    std::string study = kStudy;
+    study.replace(study.find("name: no_bite"), 13, "name: " + name);
+    const std::string dir = study_folder(study);
+    const std::string out = name == "cube.yaml" ? dir + "/base" : dir + "/out";
+    if (name == "notes.txt") {
+      fs::create_directories(out);
+      test::write_file(out + "/notes.txt", "hi\n");
+    }
+    const auto before = test::files_under(out);
+    const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", out});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(r.err,
+              "hexbite: error: " + dir + "/study.yaml:8:5: variant '" + name + "': its run folder '" + out +
+                  "/" + name +
+                  "' is a file, not a folder; rename the variant (its name names the folder), remove or "
+                  "rename the file, or choose another output folder\n");
+    EXPECT_EQ(r.out.find("variant 1"), std::string::npos) << r.out;
+    test::expect_same_files(before, test::files_under(out));
+  }
+}
+
+// Into a file or a pipe, the lines that announce the variants waited in the buffer until something else
+// flushed it (the first solve) or the study ended, and a kill (a batch system's time limit) lost them. The
+// study is stopped as soon as its first line is in the file: while the variants are checked, not after.
+TEST(Study, TheVariantsAreAnnouncedAtOnceIntoAFile) {
+  const std::string dir = study_folder(kStudy);
+  const test::CommandResult r =
+      test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out", "--levels", "2"},
+                        {"bash", "-c",
+                         "\"$@\" & for i in $(seq 600); do [ -s /dev/stdout ] && break; sleep 0.1; done; "
+                         "kill -TERM $!; wait $!",
+                         "bash"});
+  EXPECT_EQ(r.exit_code, 128 + SIGTERM) << "the study ended before its first line was in the file\n" << r.out;
+  EXPECT_EQ(r.out.rfind("check variant 1 / 3: reference\n", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.find("\nvariant 1 / 3: reference"), std::string::npos) << "in the file only once solving:\n"
+                                                                         << r.out;
 }
 
 // A missing, empty or non-text base was told "write a word such as left_condyle", the hint for point names.
