@@ -5,8 +5,9 @@
 // study.csv and study.md compare the variants with the first one.
 //
 // Every variant is checked before the first solve: the study file and each variant's scenario when the
-// study is loaded (scenarios/study.h), then each variant's geometry, meshes and patches (prepare_run), so a
-// bad value in the last variant costs no solve. All or nothing: the variants' folders and the tables are
+// study is loaded (scenarios/study.h), that no file or link in DIR is where a variant's folder goes, then
+// each variant's geometry, meshes and patches (prepare_run), so a bad value in the last variant costs no
+// solve. All or nothing: the variants' folders and the tables are
 // written into one hidden stage folder in DIR (common/output_stage.h) and moved into DIR only when every
 // variant has solved and passed the checks of `hexbite run` (equilibrium, small displacements); any failure
 // leaves DIR as it was. One process only: under mpirun it is refused.
