@@ -80,7 +80,12 @@ class GenerateOutputs {
   // Moves every staged file into its folder (a .mhd's data file too, which the writer names itself). Every
   // folder is checked before the first is moved in: a folder in the way of a DICOM slice's name failed the
   // DICOM folder's commit after the surface, landmarks and CT were in place, replacing the earlier ones.
+  // The folders stay locked over all the moves, and signals wait: another generate into the same folders
+  // moved its surface in between ours and our DICOM series.
   void commit() {
+    std::vector<std::string> dirs;
+    for (const auto& stage : stages_) dirs.push_back(stage->dir());
+    const CommitLock locked(dirs);
     std::vector<std::vector<std::string>> files(stages_.size());
     for (std::size_t i = 0; i < stages_.size(); ++i) {
       for (const fs::directory_entry& entry : fs::directory_iterator(stages_[i]->stage_dir()))

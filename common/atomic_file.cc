@@ -1,5 +1,7 @@
 #include "common/atomic_file.h"
 
+#include <dirent.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,15 +28,57 @@ namespace {
 constexpr int kSlots = 32;
 constexpr std::size_t kSlotBytes = 4096;
 char g_paths[kSlots][kSlotBytes];
-std::atomic<int> g_state[kSlots];  // 0 free, 1 being filled, 2 a registered file, 3 a registered folder
+std::atomic<int> g_state[kSlots];  // 0 free, 1 being filled, then 2 + RemovedOnSignal::Kind
 
-extern "C" void remove_temporaries_and_die(int signal_number) {
+// Whether signals act now (kRunning), wait for the end of a SignalsDeferred (kDeferring, the waiting one in
+// g_pending), or one is ending the process already (kEnding: a second signal, on another thread, does
+// nothing).
+enum Phase { kRunning, kDeferring, kEnding };
+std::atomic<int> g_phase{kRunning};
+std::atomic<int> g_pending{0};
+int g_deferrals = 0;  // SignalsDeferred alive (on the one thread that defers)
+
+// Removes the folder `name` in the folder `at` with everything in it. By system calls alone: opendir and
+// std::filesystem allocate, and a handler that allocates hangs when the signal came inside malloc. Each
+// level holds a descriptor and a small buffer on the stack, and a stage is a few levels deep (a study's
+// variant's stage); a name that cannot be removed is left, as the process ends anyway.
+void remove_tree_at(int at, const char* name) {
+  const int fd = ::openat(at, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return;
+  alignas(dirent64) char entries[2048];
+  for (ssize_t n; (n = ::getdents64(fd, entries, sizeof entries)) > 0;)
+    for (ssize_t at_byte = 0; at_byte < n;) {
+      const auto* entry = reinterpret_cast<const dirent64*>(entries + at_byte);
+      at_byte += entry->d_reclen;
+      const char* child = entry->d_name;
+      if (std::strcmp(child, ".") == 0 || std::strcmp(child, "..") == 0) continue;
+      if (::unlinkat(fd, child, 0) != 0 && errno == EISDIR) remove_tree_at(fd, child);
+    }
+  ::close(fd);
+  ::unlinkat(at, name, AT_REMOVEDIR);
+}
+
+void remove_temporaries_and_die(int signal_number) {
   for (int i = 0; i < kSlots; ++i)
-    if (g_state[i].load() == 2) ::unlink(g_paths[i]);
-  for (int i = 0; i < kSlots; ++i)  // folders after their files
-    if (g_state[i].load() == 3) ::rmdir(g_paths[i]);
+    if (g_state[i].load() == 2 + RemovedOnSignal::kFile) ::unlink(g_paths[i]);
+  for (int i = 0; i < kSlots; ++i)
+    if (g_state[i].load() == 2 + RemovedOnSignal::kTree) remove_tree_at(AT_FDCWD, g_paths[i]);
+  // Folders after their files, and until none more goes: a folder in a registered folder empties it.
+  for (bool removed = true; removed;) {
+    removed = false;
+    for (int i = 0; i < kSlots; ++i)
+      if (g_state[i].load() == 2 + RemovedOnSignal::kFolder && ::rmdir(g_paths[i]) == 0) removed = true;
+  }
   std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
+}
+
+extern "C" void on_signal(int signal_number) {
+  int phase = kRunning;
+  if (g_phase.compare_exchange_strong(phase, kEnding))
+    remove_temporaries_and_die(signal_number);
+  else if (phase == kDeferring)
+    g_pending.store(signal_number);
 }
 
 }  // namespace
@@ -45,7 +89,7 @@ RemovedOnSignal::RemovedOnSignal(const std::string& path, Kind kind) {
     int expected = 0;
     if (!g_state[i].compare_exchange_strong(expected, 1)) continue;
     std::memcpy(g_paths[i], path.c_str(), path.size() + 1);
-    g_state[i].store(kind == kFolder ? 3 : 2);
+    g_state[i].store(2 + kind);
     slot_ = i;
     return;
   }
@@ -57,7 +101,21 @@ RemovedOnSignal::~RemovedOnSignal() {
 
 void remove_temporary_files_on_signals() {
   static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads these atomics");
-  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal_number, remove_temporaries_and_die);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal_number, on_signal);
+}
+
+SignalsDeferred::SignalsDeferred() {
+  if (g_deferrals++ > 0) return;
+  int phase = kRunning;
+  if (!g_phase.compare_exchange_strong(phase, kDeferring))
+    for (;;) ::pause();  // a signal on another thread is ending the process: start nothing more
+}
+
+SignalsDeferred::~SignalsDeferred() {
+  if (--g_deferrals > 0) return;
+  g_phase.store(kRunning);
+  const int pending = g_pending.exchange(0);
+  if (pending != 0) on_signal(pending);  // as if it came now
 }
 
 void write_atomically(const std::string& final_path, const std::function<void(const std::string&)>& write) {

@@ -17,12 +17,13 @@ void write_atomically(const std::string& final_path, const std::function<void(co
 void remove_temporary_files_on_signals();
 
 // While it lives, `path` is removed by those handlers too: a file unlinked, a folder (kFolder) removed after
-// every registered file, so a temporary folder whose files are registered goes whole. For temporary files
-// that write_atomically does not make (the report's pictures). At most 32 paths at once, each shorter than
-// 4096 bytes; others are not registered (left behind on a signal).
+// every registered file and tree when it is empty by then, so a temporary folder whose files are registered
+// goes whole, a folder with everything in it (kTree: an output stage, common/output_stage.h). For temporary
+// files that write_atomically does not make (the report's pictures). At most 32 paths at once, each shorter
+// than 4096 bytes; others are not registered (left behind on a signal).
 class RemovedOnSignal {
  public:
-  enum Kind { kFile, kFolder };
+  enum Kind { kFile, kFolder, kTree };
   explicit RemovedOnSignal(const std::string& path, Kind kind = kFile);
   ~RemovedOnSignal();
   RemovedOnSignal(const RemovedOnSignal&) = delete;
@@ -30,6 +31,19 @@ class RemovedOnSignal {
 
  private:
   int slot_ = -1;
+};
+
+// While it lives, SIGINT, SIGTERM and SIGHUP wait: those handlers note the signal and return, and it acts
+// when the last SignalsDeferred ends (removing the temporary files registered then, ending the process). For
+// moving a set of outputs into place: a signal in the middle left some of them new and some old. Signals
+// delivered to any thread wait (a mask would hold them only in the calling thread). Only one thread at a time
+// may defer them.
+class SignalsDeferred {
+ public:
+  SignalsDeferred();
+  ~SignalsDeferred();
+  SignalsDeferred(const SignalsDeferred&) = delete;
+  SignalsDeferred& operator=(const SignalsDeferred&) = delete;
 };
 
 // The temporary name beside `final_path` that its content is written to first: hidden, with the process id,

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <stdlib.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <map>
 #include <set>
 
 #include "common/atomic_file.h"
@@ -64,7 +66,47 @@ void remove_abandoned_stages(const fs::path& dir) {
   }
 }
 
+// The folders this process holds locked (CommitLock), by device and inode: the descriptor holding the flock
+// and how many CommitLocks hold it. Commits run on one thread.
+struct HeldFolder {
+  int fd = -1;
+  int holders = 0;
+};
+std::map<std::pair<dev_t, ino_t>, HeldFolder> g_held;
+
 }  // namespace
+
+CommitLock::CommitLock(const std::vector<std::string>& dirs) {
+  std::map<std::pair<dev_t, ino_t>, int> opened;  // sorted: the order every process locks in
+  for (const std::string& dir : dirs) {
+    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    struct stat st {};
+    if (fd < 0) continue;  // the commit names what is wrong with the folder
+    if (::fstat(fd, &st) != 0 || !opened.emplace(std::make_pair(st.st_dev, st.st_ino), fd).second)
+      ::close(fd);
+  }
+  for (const auto& [folder, fd] : opened) {
+    HeldFolder& held = g_held[folder];
+    if (held.holders++ > 0) {
+      ::close(fd);
+    } else {
+      held.fd = fd;
+      while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+    }
+    held_.push_back(folder);
+  }
+  deferred_.emplace();
+}
+
+CommitLock::~CommitLock() {
+  for (const auto& folder : held_) {
+    const auto it = g_held.find(folder);
+    if (--it->second.holders > 0) continue;
+    ::close(it->second.fd);  // lets go of the flock
+    g_held.erase(it);
+  }
+}
 
 OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separator(dir)) {
   // The folders that do not exist yet, deepest first: a failed run removes them again.
@@ -74,6 +116,8 @@ OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separat
     created_.push_back(p);
     if (p == p.parent_path()) break;
   }
+  for (const fs::path& p : created_)
+    on_signal_.push_back(std::make_unique<RemovedOnSignal>(p.string(), RemovedOnSignal::kFolder));
   fs::create_directories(dir_, ec);
   if (ec) {
     discard();
@@ -88,6 +132,7 @@ OutputStage::OutputStage(const std::string& dir) : dir_(without_trailing_separat
                    "; make it writable or choose another output folder");
   }
   stage_ = name;
+  on_signal_.push_back(std::make_unique<RemovedOnSignal>(stage_, RemovedOnSignal::kTree));
   // Marks the stage as in use for remove_abandoned_stages() of other runs into the same folder. On a file
   // system without flock their lock fails as well, and they leave the stage alone.
   lock_ = ::open(stage_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -102,13 +147,14 @@ void OutputStage::discard() noexcept {
   done_ = true;
   std::error_code ec;
   if (!stage_.empty()) fs::remove_all(stage_, ec);
-  unlock();
   for (const fs::path& p : created_) fs::remove(p, ec);  // only if empty: never what others put there
+  release();
 }
 
-void OutputStage::unlock() noexcept {
+void OutputStage::release() noexcept {
   if (lock_ >= 0) ::close(lock_);
   lock_ = -1;
+  on_signal_.clear();
 }
 
 std::string OutputStage::blocked(const std::vector<std::string>& files) const {
@@ -131,6 +177,7 @@ std::string OutputStage::blocked(const std::vector<std::string>& files) const {
 
 void OutputStage::commit(const std::vector<std::string>& files,
                          const std::function<bool(const std::string&)>& retire) {
+  const CommitLock locked({dir_});
   const fs::path dir(dir_), stage(stage_), previous = fs::path(stage_) / ".previous";
   // Every move done so far, to be undone (last first) when a later one fails; a move without `from` is a
   // folder made in the output folder, removed again.
@@ -206,8 +253,8 @@ void OutputStage::commit(const std::vector<std::string>& files,
       if (ec) stuck += (stuck.empty() ? "" : ", ") + it->to.string();
     }
     if (!stuck.empty()) {
-      done_ = true;  // keep the stage
-      unlock();
+      done_ = true;  // keep the stage, and on a signal too
+      release();
       throw RunError(std::string(e.what()) + "; moving the earlier files back failed as well: " + stuck +
                      " are in " + stage_ + ", move them back by hand");
     }
@@ -218,7 +265,7 @@ void OutputStage::commit(const std::vector<std::string>& files,
   // The set is in place; what is left in the stage are the earlier run's replaced files.
   std::error_code ec;
   fs::remove_all(stage_, ec);
-  unlock();
+  release();
 }
 
 std::string named_in_dir(std::string message, const std::string& stage_dir, const std::string& dir) {

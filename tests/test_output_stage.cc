@@ -9,8 +9,11 @@
 #include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <functional>
 #include <map>
+#include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -211,6 +214,157 @@ TEST(OutputStage, AnAbandonedStageIsRemovedByTheNextOne) {
       << err;
   live.commit({"out_a"}, is_output);
   EXPECT_EQ(test::read_file(dir + "/out_a"), "live a\n");
+}
+
+// Runs `body` in a child process, which exits 0 when it returns and 1 when it throws; returns its id.
+pid_t fork_child(const std::function<void()>& body) {
+  const pid_t child = fork();
+  if (child != 0) return child;
+  try {
+    body();
+  } catch (...) {
+    std::_Exit(1);
+  }
+  std::_Exit(0);
+}
+
+int wait_for(pid_t child) {
+  int status = 0;
+  EXPECT_EQ(waitpid(child, &status, 0), child);
+  return status;
+}
+
+// Two runs into one folder at once: the moves were not locked across runs, and a run whose commit came in
+// the middle of another's left one's mesh.vtu beside the other's results.json, both exit 0 (hunt U1). Here
+// the second commit starts while the first one lists the folder: it waits, then replaces the whole set.
+TEST(OutputStage, ASecondCommitIntoTheFolderWaitsAndReplacesTheWholeSet) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/notes.txt", "mine\n");
+  int go[2];
+  ASSERT_EQ(pipe(go), 0);
+  const pid_t child = fork_child([&] {
+    OutputStage stage(dir);
+    for (const char* name : {"out_a", "out_b", "out_c"})
+      test::write_file(stage.stage_dir() + "/" + name, std::string("second ") + name + "\n");
+    char byte = 0;
+    if (read(go[0], &byte, 1) != 1) throw std::runtime_error("no go");
+    stage.commit({"out_a", "out_b", "out_c"}, is_output);
+  });
+  ASSERT_GT(child, 0);
+  {
+    OutputStage stage(dir);
+    for (const char* name : {"out_a", "out_b"})
+      test::write_file(stage.stage_dir() + "/" + name, std::string("first ") + name + "\n");
+    bool started = false;
+    stage.commit({"out_a", "out_b"}, [&](const std::string& name) {
+      if (!started) {  // the second run's commit starts now, and has the time to finish
+        started = true;
+        EXPECT_EQ(write(go[1], "x", 1), 1);
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      }
+      return is_output(name);
+    });
+  }
+  const int status = wait_for(child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  const std::map<std::string, std::string> second = {{"out_a", "second out_a\n"},
+                                                     {"out_b", "second out_b\n"},
+                                                     {"out_c", "second out_c\n"},
+                                                     {"notes.txt", "mine\n"}};
+  EXPECT_EQ(test::files_under(dir), second);
+  close(go[0]);
+  close(go[1]);
+}
+
+// generate commits up to three folders: another generate's commit came between its surface's folder and
+// its DICOM folder. A CommitLock over all of them holds off another process's commit into any.
+TEST(OutputStage, ACommitWaitsWhileAnotherProcessHoldsItsFolderWithOthers) {
+  const std::string one = test::temp_dir(), two = test::temp_dir();
+  int go[2];
+  ASSERT_EQ(pipe(go), 0);
+  const pid_t child = fork_child([&] {  // before the lock: a child would share its descriptors
+    OutputStage stage(two);
+    test::write_file(stage.stage_dir() + "/out_a", "a\n");
+    char byte = 0;
+    if (read(go[0], &byte, 1) != 1) throw std::runtime_error("no go");
+    stage.commit({"out_a"}, is_output);
+  });
+  {
+    const CommitLock locked({one, two});
+    EXPECT_EQ(write(go[1], "x", 1), 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_FALSE(fs::exists(two + "/out_a")) << "the commit did not wait";
+  }
+  close(go[0]);
+  close(go[1]);
+  ASSERT_GT(child, 0);
+  const int status = wait_for(child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_EQ(test::read_file(two + "/out_a"), "a\n");
+}
+
+// Ctrl-C, SIGTERM or SIGHUP in the middle of the moves left the new mesh.vtu beside the old solution.vtu
+// and results.json, or no solution.vtu at all (hunt U2). A signal during the commit waits for its end, on
+// whichever thread it comes (a process's signal goes to any thread that does not block it).
+TEST(OutputStage, ASignalDuringTheCommitActsWhenTheSetIsWhole) {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP})
+    for (bool other_thread : {false, true}) {
+      const std::string dir = test::temp_dir();
+      test::write_file(dir + "/out_a", "old a\n");
+      test::write_file(dir + "/out_stale", "old stale\n");
+      const pid_t child = fork_child([&] {
+        remove_temporary_files_on_signals();
+        OutputStage stage(dir);
+        test::write_file(stage.stage_dir() + "/out_a", "new a\n");
+        test::write_file(stage.stage_dir() + "/out_b", "new b\n");
+        bool raised = false;
+        stage.commit({"out_a", "out_b"}, [&](const std::string& name) {
+          if (!raised) {
+            raised = true;
+            if (other_thread)
+              std::thread([&] { std::raise(signal_number); }).join();
+            else
+              std::raise(signal_number);
+          }
+          return is_output(name);
+        });
+      });
+      ASSERT_GT(child, 0);
+      const int status = wait_for(child);
+      EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number)
+          << "signal " << signal_number << (other_thread ? " on another thread" : "");
+      const std::map<std::string, std::string> whole = {{"out_a", "new a\n"}, {"out_b", "new b\n"}};
+      EXPECT_EQ(test::files_under(dir), whole) << "signal " << signal_number;
+    }
+}
+
+// A signal while the files were written into the stage left the stage, with its files and folders (a
+// study's variants, a DICOM series), and the output folder that the run had created (hunt U10).
+TEST(OutputStage, ASignalBeforeTheCommitRemovesTheStageAndTheFoldersItCreated) {
+  for (bool existing : {false, true}) {
+    const std::string root = test::temp_dir();
+    const std::string dir = root + "/new/out";
+    if (existing) {
+      fs::create_directories(dir);
+      test::write_file(dir + "/notes.txt", "mine\n");
+    }
+    const std::map<std::string, std::string> before = test::files_under(root);
+    const pid_t child = fork_child([&] {
+      remove_temporary_files_on_signals();
+      OutputStage stage(dir);
+      for (int i = 1; i <= 86; ++i) test::write_file(stage.stage_dir() + "/ct_" + std::to_string(i), "slice");
+      OutputStage variant(stage.stage_dir() + "/v1");  // a study's variant, staged in the study's stage
+      test::write_file(variant.stage_dir() + "/out_a", "a\n");
+      write_atomically(variant.stage_dir() + "/out_b", [&](const std::string& tmp) {
+        test::write_file(tmp, "half");
+        std::raise(SIGTERM);
+      });
+    });
+    ASSERT_GT(child, 0);
+    const int status = wait_for(child);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM);
+    EXPECT_EQ(test::files_under(root), before) << (existing ? "existing folder" : "new folder");
+  }
 }
 
 // A folder that did not exist (nor its parent) is gone again when the set is given up.
