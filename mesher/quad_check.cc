@@ -473,7 +473,7 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
         "graph not simple: " + count(r.duplicate_quads, "duplicate quad", "duplicate quads") +
         " (the same vertices as an earlier quad; the first: " + first_duplicate +
         "); remove the repeated quads");
-  if (r.quad_pairs_sharing_edges > 0)
+  if (r.quad_pairs_sharing_edges > 0 && r.degenerate_quads == 0)  // a degenerate quad may pair with itself
     r.problems.push_back("graph not simple: " +
                          count(r.quad_pairs_sharing_edges, "pair of quads shares", "pairs of quads share") +
                          " two or more edges (the first: " + first_sharing +
