@@ -6,8 +6,9 @@
 // Reports what the sheet mesher (hexbite mesh --method sheets) needs to know about a quad surface: closed,
 // manifold, genus, even quad count, simple, planar and 3-connected graph, the chords with their lengths and
 // every self-intersecting chord with the quads it crosses twice; then, geometrically, quads that cross each
-// other (mesher/quad_surface_crossings.h) and quad corners on one line. The report is printed in full even
-// when the surface is unusable; then every problem also goes to standard error and the exit code is 2.
+// other (mesher/quad_surface_crossings.h) and quad corners on one line or reflex. The report is printed in
+// full even when the surface is unusable; then every problem also goes to standard error and the exit code
+// is 2.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>
@@ -142,14 +143,14 @@ std::string report_text(const QuadSurfaceReport& r, const Crossings& crossings) 
 }
 
 void run_quad_check(const QuadCheckOptions& o) {
-  const QuadSurface surface = read_quad_surface(o.file);
+  const QuadSurface surface = load_quad_surface_input(o.file);
   QuadSurfaceReport report = check_quad_surface(surface, o.file);
   // "usable for --method sheets" means with the embedding, which keeps the boundary as it is: a quad
-  // corner on one line with its neighbours makes every mesh invalid (it was "usable: yes", and the mesh
-  // command then refused the surface).
+  // corner on one line with its neighbours, or a reflex one, makes every mesh invalid (it was "usable: yes",
+  // and the mesh command then refused the surface or left hexes inverted).
   if (report.closed && report.manifold)
-    if (const std::string flat = collinear_corners_problem(surface); !flat.empty())
-      report.problems.push_back(flat);
+    if (const std::string corner = non_convex_corners_problem(surface); !corner.empty())
+      report.problems.push_back(corner);
   // A surface folded over itself passes every combinatorial test, and the mesh command then left hexes
   // inverted.
   Crossings crossings;

@@ -6,6 +6,7 @@
 
 #include "common/error.h"
 #include "mesher/hex_quality.h"
+#include "mesher/quad_surface_io.h"
 #include "mesher/surface_check.h"
 #include "mesher/units.h"
 
@@ -51,12 +52,19 @@ std::function<std::string(int)> HexMeshInput::hex_label() const {
   return [this](int h) { return " (" + element_suffix(h).substr(2) + ")"; };
 }
 
-std::string mesh_size_warning(double largest_extent_mm) {
-  return implausible_size_warning(
-      largest_extent_mm, "mm",
-      "scale the mesh from <unit> to millimetres where it was made: hex mesh files "
-      "are read in mm, and no option sets their unit",
-      "mesh");
+std::string mesh_size_warning(double largest_extent_mm, const std::string& what, const std::string& files) {
+  return implausible_size_warning(largest_extent_mm, "mm",
+                                  "scale the " + what + " from <unit> to millimetres where it was made: " +
+                                      files + " are read in mm, and no option sets their unit",
+                                  what);
+}
+
+QuadSurface load_quad_surface_input(const std::string& path) {
+  QuadSurface surface = read_quad_surface(path);
+  const std::string warning =
+      mesh_size_warning(largest_extent(surface.vertices), "quad surface", "quad surface files");
+  if (!warning.empty()) std::cerr << "hexbite: warning: '" << path << "': " << warning << '\n';
+  return surface;
 }
 
 HexMeshInput load_hex_mesh_input(const std::string& path, std::vector<MeshArray>* cell_arrays,

@@ -52,8 +52,15 @@ HexMeshInput load_hex_mesh_input(const std::string& path, std::vector<MeshArray>
                                  std::vector<std::string>* not_read = nullptr);
 
 // The size warning of load_hex_mesh_input() for a mesh whose largest side is `largest_extent_mm`, without
-// "hexbite: warning: "; empty for a plausible size.
-std::string mesh_size_warning(double largest_extent_mm);
+// "hexbite: warning: "; empty for a plausible size. `what` names the object and `files` its files, both read
+// in mm.
+std::string mesh_size_warning(double largest_extent_mm, const std::string& what = "mesh",
+                              const std::string& files = "hex mesh files");
+
+// Reads the quad surface `path` (read_quad_surface) for `quad check` and `mesh --quad-surface`, with the
+// size warning of a mesh: it is meshed in its own coordinates, read as mm, so one in metres comes out 1000
+// times too small (and an .inp states mm).
+QuadSurface load_quad_surface_input(const std::string& path);
 
 // For the commands that read a hex mesh and cannot work on an inverted one (`refine`, `quad from-mesh`):
 // throws an InputError naming the inverted hexes of `input` (read from `path`; a corner Jacobian <= 0 or

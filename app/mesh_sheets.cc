@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/mesh_inputs.h"
 #include "common/error.h"
 #include "common/json_text.h"
 #include "common/number_format.h"
@@ -13,7 +14,6 @@
 #include "mesher/hex_mesh_io.h"
 #include "mesher/hex_quality.h"
 #include "mesher/quad_surface_crossings.h"
-#include "mesher/quad_surface_io.h"
 #include "postprocess/quality_json.h"
 
 namespace hexbite {
@@ -54,7 +54,7 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
         "--method sheets needs a SURFACE (a mandible: the quad template is placed on it) or --quad-surface "
         "Q.obj (a quad surface of a ball)");
   const EliminationOrder order = parse_elimination_order(o.order);
-  const QuadSurface surface = read_quad_surface(o.quad_surface);
+  const QuadSurface surface = load_quad_surface_input(o.quad_surface);
   // A folded surface passes the elimination's combinatorial tests and leaves hexes inverted after the
   // whole run; it is refused first (--allow-invalid meshes it anyway, and the crossing is named as a
   // warning).
@@ -95,9 +95,9 @@ void run_mesh_sheets(const MeshSheetsOptions& o) {
   if (!valid && !o.allow_invalid)
     throw RunError(
         stay_inverted_text(mesh, report.quality.inverted_hexes) +
-        "; a quad corner there may be reflex (a non-convex quad: no hex on it has a positive Jacobian at "
-        "that corner) or the quads too bent for the hexes under them: check the quad surface there, or mesh "
-        "the solid with --method grid; no mesh written (--allow-invalid writes it anyway)");
+        "; the quads there may be too bent for the hexes under them (reflex and collinear corners are "
+        "refused before the work): check the quad surface there, or mesh the solid with --method grid; no "
+        "mesh written (--allow-invalid writes it anyway)");
   if (!o.json) info("wrote " + o.output);
 }
 

@@ -182,8 +182,12 @@ void add_refine_options(CLI::App& cmd, RefineCommandOptions& o) {
       "--refine-at", o.at,
       "Refine the quad surface locally around this point (the bite point): X,Y,Z in mm, or a name in the "
       "--landmarks file such as right_first_molar_bite_point");
+  // number_in_range, as the other real options: CLI::Range answered "Value abc not in range 1.000000 to
+  // 30.000000" and let NaN through to a third wording.
+  char range[64];
+  std::snprintf(range, sizeof range, "from %g to %g (mm)", kMinRefineRadiusMm, kMaxRefineRadiusMm);
   cmd.add_option("--refine-radius", o.radius_mm, "Radius of the refined patch around --refine-at, in mm")
-      ->check(CLI::Range(kMinRefineRadiusMm, kMaxRefineRadiusMm))
+      ->check(number_in_range(kMinRefineRadiusMm, kMaxRefineRadiusMm, range))
       ->capture_default_str()
       ->needs(at);
   cmd.add_option("--refine-levels", o.levels,
@@ -200,11 +204,12 @@ void run_quad_from_mandible(const MandibleQuadCommandOptions& o) {
   QuadSurfaceReport check;
   LocalRefinementReport refinement_report;
   QuadSurface quads;
+  const InputTerms terms = quad_command_terms(o.units);
   try {
     quads = checked_mandible_quads(surface, landmarks.get(), o.target_quads, o.surface, o.landmarks, &report,
-                                   &check, refinement, &refinement_report);
+                                   &check, refinement, &refinement_report, terms);
   } catch (const RunError& e) {
-    throw RunError(std::string(e.what()) + "; use --method grid for this surface");
+    throw RunError(std::string(e.what()) + "; use " + terms.grid_method + " for this surface");
   }
   write_quad_obj(o.output, quads);
   if (o.json) {
@@ -232,6 +237,7 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
   const auto [surface, landmarks] = load_mesh_inputs(qo.surface, qo.units, qo.landmarks);
   options.refinement = refinement_options(qo.refine, landmarks.get(), qo.landmarks);
   options.fit_volume = o.fit_volume;
+  options.terms = mesh_command_terms(qo.units);
   MandibleSheetReport sheet_report;
   HexMesh mesh;
   try {

@@ -228,7 +228,7 @@ HexMesh mesh_by_sheets(const Scenario& s, const Geometry& geometry, MeshFidelity
       }
   }
   options.fit_volume = s.mesh.fit_volume;
-  options.terms = scenario_terms();
+  options.terms = scenario_terms(s.geometry.units);
   MandibleSheetReport report;
   HexMesh mesh;
   try {

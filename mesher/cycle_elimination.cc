@@ -767,12 +767,14 @@ HexMesh mesh_by_cycle_elimination(const QuadSurface& input, const SheetMeshOptio
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   const QuadSurface surface = facing_outward(input);
+  // The embedding keeps the boundary where it is: a quad corner on one line with its neighbours, or a
+  // reflex one, leaves every hex there with a corner Jacobian of 0 or below, so the elimination (up to
+  // minutes) is not started.
+  if (options.optimize)
+    if (const std::string corner = non_convex_corners_problem(surface); !corner.empty())
+      throw InputError(corner);
   SheetMeshReport counts;
   HexMesh mesh = sheet_complex(surface, options, 0, options.decomposition.max_depth, counts);
-  // The embedding keeps the boundary where it is: a quad corner on one line with its neighbours leaves
-  // every hex there with a zero corner Jacobian.
-  if (options.optimize)
-    if (const std::string flat = collinear_corners_problem(surface); !flat.empty()) throw InputError(flat);
   const auto t1 = Clock::now();
   const int n = static_cast<int>(surface.vertices.size());
   OptimizeReport opt = embed(mesh, n, options);

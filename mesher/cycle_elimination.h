@@ -56,8 +56,9 @@
 // Failure: when no elimination is feasible before the cube, RunError naming the remaining chords and some of
 // their quads, suggesting --method grid; from mesh_by_cycle_elimination() only when no decomposition helps
 // either, saying how many cycles and splits were tried. With the embedding (SheetMeshOptions::optimize,
-// the boundary fixed), InputError after the construction for a quad with three collinear corners: every
-// hex on it has a corner Jacobian of 0 there, so no valid mesh with that boundary exists.
+// the boundary fixed), InputError before the elimination for a quad corner that is collinear or reflex
+// (non_convex_corners_problem()): every hex on that quad has a corner Jacobian of 0 or below there, so no
+// valid mesh with that boundary exists.
 // Cost: per step, the chords and sides O(C F) for C chords and F quads, each feasibility test O(F log F);
 // kFewestHexes usually tests one candidate per step, the look-ahead orders up to all candidates of the next
 // step; the geometric order also measures the rail angles and the flatness of every candidate, O(C F) per
@@ -177,9 +178,10 @@ struct SheetMeshReport {
 };
 
 // Steps 1 to 3, with the look-ahead order and then decomposition where the elimination is stuck. The counts
-// of eliminations and sheets add up over the parts of a decomposition. With options.optimize, InputError when
-// a quad has three collinear corners (no valid hex mesh has that boundary). Quads that all face inward (a
-// negative enclosed volume) are meshed with their corners reversed: the same solid, no inverted hexes.
+// of eliminations and sheets add up over the parts of a decomposition. With options.optimize, InputError
+// first when a quad corner is collinear or reflex (no valid hex mesh has that boundary). Quads that all face
+// inward (a negative enclosed volume) are meshed with their corners reversed: the same solid, no inverted
+// hexes.
 HexMesh mesh_by_cycle_elimination(const QuadSurface& surface, const SheetMeshOptions& options,
                                   SheetMeshReport* report = nullptr);
 

@@ -11,13 +11,35 @@ struct InputTerms {
   std::string sheets_method = "--method sheets";
   std::string target_hexes = "--target-hexes";
   std::string landmarks = "--landmarks";
-  std::string units = "--units m or cm";
+  std::string units = "give --units <unit>";  // how to read the surface in another unit ("<unit>" replaced)
+  std::string surface_unit = "mm";            // the unit the surface was read in
 };
 
-// The terms of a scenario file (docs/scenario-format.md).
-inline InputTerms scenario_terms() {
-  return {"method: grid", "method: sheets", "mesh.target_hexes", "landmarks: {file: ...}",
-          "units: m or cm in geometry.surface"};
+// The terms of `hexbite quad from-mandible`, which has no --method: the grid mesher is another command.
+inline InputTerms quad_command_terms(const std::string& surface_unit) {
+  return {"hexbite mesh --method grid",
+          "hexbite mesh --method sheets",
+          "--target-hexes",
+          "--landmarks",
+          "give --units <unit>",
+          surface_unit};
+}
+
+// The terms of `hexbite mesh`, reading its surface in `surface_unit`.
+inline InputTerms mesh_command_terms(const std::string& surface_unit) {
+  InputTerms terms;
+  terms.surface_unit = surface_unit;
+  return terms;
+}
+
+// The terms of a scenario file (docs/scenario-format.md) whose surface is read in `surface_unit`.
+inline InputTerms scenario_terms(const std::string& surface_unit) {
+  return {"method: grid",
+          "method: sheets",
+          "mesh.target_hexes",
+          "landmarks: {file: ...}",
+          "write units: <unit> in geometry.surface",
+          surface_unit};
 }
 
 }  // namespace hexbite

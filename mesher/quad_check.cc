@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/boyer_myrvold_planar_test.hpp>
+#include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <stdexcept>
@@ -113,11 +114,14 @@ std::string vertex_at(const QuadSurface& surface, int v) {
   return text;
 }
 
-// "quad 5 (vertices 3, 7, 8, 4)".
+// "quad 5 (vertices 3, 7, 8, 4; centre (0.5, 1, 2))".
 std::string quad_at(const QuadSurface& surface, std::size_t q) {
   const std::array<int, 4>& quad = surface.quads[q];
+  const Vec3 c = quad_centre(surface, static_cast<int>(q));
+  char centre[96];
+  std::snprintf(centre, sizeof centre, "; centre (%g, %g, %g))", c[0], c[1], c[2]);
   return "quad " + std::to_string(q) + " (vertices " + std::to_string(quad[0]) + ", " +
-         std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) + ")";
+         std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " + std::to_string(quad[3]) + centre;
 }
 
 // "edge 3-7 of quad 5, from (...) to (...)".
@@ -132,25 +136,67 @@ std::string edge_at(const QuadSurface& surface, const std::array<int, 2>& e, int
 
 }  // namespace
 
-std::string collinear_corners_problem(const QuadSurface& surface) {
-  int flat = 0;
-  std::string first;
-  for (std::size_t q = 0; q < surface.quads.size(); ++q)
+Vec3 quad_centre(const QuadSurface& surface, int q) {
+  Vec3 c{0, 0, 0};
+  for (int v : surface.quads[static_cast<std::size_t>(q)]) c = vec3::add(c, surface.vertices[v]);
+  return vec3::scale(c, 0.25);
+}
+
+std::string non_convex_corners_problem(const QuadSurface& surface) {
+  int collinear = 0, reflex = 0;
+  std::string first_collinear, first_reflex;
+  for (std::size_t q = 0; q < surface.quads.size(); ++q) {
+    const std::array<int, 4>& quad = surface.quads[q];
+    const auto at = [&](int k) { return surface.vertices[static_cast<std::size_t>(quad[k % 4])]; };
+    // The quad's normal, from its diagonals (twice its vector area): also defined for a bent quad, whose
+    // corners are convex when they turn the same way about it as the quad's corners go round.
+    const Vec3 normal = vec3::cross(vec3::sub(at(2), at(0)), vec3::sub(at(3), at(1)));
     for (int k = 0; k < 4; ++k) {
-      const std::array<int, 4>& quad = surface.quads[q];
       const int a = quad[(k + 3) % 4], b = quad[k], c = quad[(k + 1) % 4];
-      const Vec3 u = vec3::sub(surface.vertices[a], surface.vertices[b]);
-      const Vec3 w = vec3::sub(surface.vertices[c], surface.vertices[b]);
-      if (vec3::norm(vec3::cross(u, w)) > 1e-12 * vec3::norm(u) * vec3::norm(w)) continue;
-      if (flat++ > 0) continue;
-      first = quad_at(surface, q) + " has three collinear corners " + std::to_string(a) + ", " +
-              std::to_string(b) + ", " + std::to_string(c) +
-              ": every hex on it has a corner Jacobian of 0 at " + vertex_at(surface, b) +
-              " whatever the interior, so no valid hex mesh has this boundary; move that vertex off the line "
-              "(make the quad convex)";
+      const Vec3 u = vec3::sub(at(k + 3), at(k));
+      const Vec3 w = vec3::sub(at(k + 1), at(k));
+      const Vec3 turn = vec3::cross(w, u);
+      if (vec3::norm(turn) <= 1e-12 * vec3::norm(u) * vec3::norm(w)) {
+        if (collinear++ == 0)
+          first_collinear = quad_at(surface, q) + " has three collinear corners " + std::to_string(a) + ", " +
+                            std::to_string(b) + ", " + std::to_string(c) +
+                            ": every hex on it has a corner Jacobian of 0 at " + vertex_at(surface, b) +
+                            " whatever the interior, so no valid hex mesh has this boundary; move that "
+                            "vertex off the line (make the quad convex)";
+        continue;
+      }
+      if (vec3::dot(turn, normal) > 0) continue;
+      // Only a nearly planar quad's corner is sure to be reflex: its halves split along the diagonal through
+      // the corner bend by less than 60 degrees. The real jaw's template surface has quads bent by 70 to 170
+      // degrees whose diagonal normal makes a corner look reflex although it is convex on the bone; such a
+      // quad is left to the embedding (which may call it too bent).
+      const Vec3 opposite = at(k + 2);
+      const Vec3 half_c = vec3::cross(w, vec3::sub(opposite, at(k)));
+      const Vec3 half_a = vec3::cross(vec3::sub(opposite, at(k)), u);
+      if (vec3::dot(half_c, half_a) < 0.5 * vec3::norm(half_c) * vec3::norm(half_a)) continue;
+      if (reflex++ > 0) continue;
+      // The interior angle at b, seen along the normal; a quad without area (a bow tie) has none.
+      const double length = vec3::norm(normal);
+      char angle[64] = "no area";
+      if (length > 0) {
+        double degrees = std::atan2(vec3::dot(turn, vec3::scale(normal, 1 / length)), vec3::dot(u, w));
+        degrees *= 180 / M_PI;
+        std::snprintf(angle, sizeof angle, "%.0f degrees inside", degrees < 0 ? degrees + 360 : degrees);
+      }
+      first_reflex = quad_at(surface, q) + " is not convex: its corner at " + vertex_at(surface, b) +
+                     " between corners " + std::to_string(a) + " and " + std::to_string(c) + " is reflex (" +
+                     angle +
+                     "): every hex on it has a negative corner Jacobian there whatever the interior, so no "
+                     "valid hex mesh has this boundary; move that vertex out (make the quad convex)";
     }
-  if (flat == 0) return "";
-  return first + (flat > 1 ? " (" + std::to_string(flat) + " such quad corners in all)" : "");
+  }
+  const auto in_all = [](int n, const std::string& what) {
+    return n > 1 ? " (" + std::to_string(n) + " " + what + " quad corners in all)" : std::string();
+  };
+  std::string text;
+  if (collinear > 0) text = first_collinear + in_all(collinear, "such");
+  if (reflex > 0) text += (text.empty() ? "" : "; ") + first_reflex + in_all(reflex, "reflex");
+  return text;
 }
 
 QuadEdges build_quad_edges(const std::vector<std::array<int, 4>>& quads) {
@@ -280,10 +326,11 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
       sorted.push_back({s, q});
     }
     std::sort(sorted.begin(), sorted.end());
+    // Equal vertex sets sort by quad, so the earlier quad comes first.
     for (std::size_t i = 1; i < sorted.size(); ++i)
       if (sorted[i].first == sorted[i - 1].first && r.duplicate_quads++ == 0)
-        first_duplicate = "quads " + std::to_string(std::min(sorted[i - 1].second, sorted[i].second)) +
-                          " and " + std::to_string(std::max(sorted[i - 1].second, sorted[i].second));
+        first_duplicate = quad_at(surface, static_cast<std::size_t>(sorted[i].second)) +
+                          ", the same as quad " + std::to_string(sorted[i - 1].second);
   }
 
   const QuadEdges qe = build_quad_edges(quads);
@@ -292,7 +339,7 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   // One slot per quad corner; corners of the same vertex in quads joined across an edge at that vertex
   // belong to the same fan, so a vertex with corners in several fans is non-manifold.
   DisjointSets fans(4 * nq);
-  std::vector<std::array<int, 2>> sharing;  // quad pairs across manifold edges
+  std::vector<std::array<int, 3>> sharing;  // quad pairs across manifold edges, with the edge
   for (std::size_t e = 0; e < qe.edges.size(); ++e) {
     const auto& list = qe.edge_quads[e];
     if (list.size() == 1 && r.open_edges++ == 0) first_open = edge_at(surface, qe.edges[e], list[0][0]);
@@ -303,7 +350,7 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
     if (list.size() != 2) continue;
     const auto [q1, k1] = list[0];
     const auto [q2, k2] = list[1];
-    sharing.push_back({std::min(q1, q2), std::max(q1, q2)});
+    sharing.push_back({std::min(q1, q2), std::max(q1, q2), static_cast<int>(e)});
     // Quads are oriented consistently when they traverse their shared edge in opposite directions.
     const bool same_direction = quads[q1][k1] == quads[q2][k2];
     if (same_direction && r.inconsistent_edges++ == 0)
@@ -337,8 +384,21 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   for (int q = 0; q < nq; ++q)
     if (components.find(q) == q) ++r.components;
   std::sort(sharing.begin(), sharing.end());
-  for (std::size_t i = 1; i < sharing.size(); ++i)
-    if (sharing[i] == sharing[i - 1] && (i < 2 || sharing[i - 2] != sharing[i])) ++r.quad_pairs_sharing_edges;
+  std::string first_sharing;
+  const auto same_pair = [&](std::size_t i, std::size_t j) {
+    return sharing[i][0] == sharing[j][0] && sharing[i][1] == sharing[j][1];
+  };
+  for (std::size_t i = 1; i < sharing.size(); ++i) {
+    if (!same_pair(i, i - 1) || (i >= 2 && same_pair(i, i - 2))) continue;
+    if (r.quad_pairs_sharing_edges++ > 0) continue;
+    std::string shared;
+    for (std::size_t j = i - 1; j < sharing.size() && same_pair(j, i); ++j) {
+      const std::array<int, 2>& e = qe.edges[static_cast<std::size_t>(sharing[j][2])];
+      shared += (shared.empty() ? "" : ", ") + std::to_string(e[0]) + "-" + std::to_string(e[1]);
+    }
+    first_sharing = quad_at(surface, static_cast<std::size_t>(sharing[i][0])) + " and " +
+                    quad_at(surface, static_cast<std::size_t>(sharing[i][1])) + " share edges " + shared;
+  }
 
   r.closed = r.open_edges == 0;
   r.manifold = r.non_manifold_edges == 0 && r.non_manifold_vertices == 0;
@@ -407,13 +467,18 @@ QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::stri
   if (r.unused_vertices > 0)
     r.problems.push_back(count(r.unused_vertices, "vertex", "vertices") +
                          " in no quad (the first: " + first_unused + "); remove them");
-  if (r.manifold && r.degenerate_quads == 0 && !r.simple)
+  // A duplicate quad also puts its edges in four quads (not manifold); this names the cause.
+  if (r.duplicate_quads > 0)
+    r.problems.push_back(
+        "graph not simple: " + count(r.duplicate_quads, "duplicate quad", "duplicate quads") +
+        " (the same vertices as an earlier quad; the first: " + first_duplicate +
+        "); remove the repeated quads");
+  if (r.quad_pairs_sharing_edges > 0 && r.degenerate_quads == 0)  // a degenerate quad may pair with itself
     r.problems.push_back("graph not simple: " +
                          count(r.quad_pairs_sharing_edges, "pair of quads shares", "pairs of quads share") +
-                         " two or more edges, " +
-                         count(r.duplicate_quads, "duplicate quad", "duplicate quads") +
-                         (first_duplicate.empty() ? "" : " (the first: " + first_duplicate + ")"));
-  if (r.ball && r.simple && !r.three_connected) {
+                         " two or more edges (the first: " + first_sharing +
+                         "); quads of a hex mesh's boundary meet in one edge at most: remesh there");
+  if (r.ball && !r.three_connected) {
     std::string which = "two vertices";
     if (!r.separator.empty()) {
       which = vertex_at(surface, r.separator[0]);

@@ -122,13 +122,20 @@ struct QuadSurfaceReport {
 
 // Indices in the report's problems are 0-based (the OBJ's vertex k is vertex k - 1 here, its face k is quad
 // k - 1), and each problem names its first place with coordinates. The problems are combinatorial (the
-// elimination's conditions); collinear_corners_problem() is the geometric one of an embedding that keeps
+// elimination's conditions); non_convex_corners_problem() is the geometric one of an embedding that keeps
 // the boundary.
 QuadSurfaceReport check_quad_surface(const QuadSurface& surface, const std::string& file);
 
-// The quad corners whose two neighbours lie on one line with them: a hex on such a quad has a corner
-// Jacobian of 0 there whatever the interior, so no valid hex mesh has this boundary. Empty when there is
-// none, else a message naming the first corner (0-based, with coordinates) and how many there are.
-std::string collinear_corners_problem(const QuadSurface& surface);
+// The centre of quad q: the mean of its four corners.
+Vec3 quad_centre(const QuadSurface& surface, int q);
+
+// The quad corners that are not convex: collinear ones (the two neighbours on one line with the corner) and
+// reflex ones (turning against the quad's normal, the cross product of its diagonals, which a bent quad has
+// too, on a quad whose halves split along the diagonal through the corner bend by less than 60 degrees;
+// a more bent quad is left to the embedding). A hex on such a quad has a corner Jacobian of
+// 0 (collinear) or below 0 (reflex) there whatever the interior, so no valid hex mesh has this boundary.
+// Empty when there is none, else a message naming the first corner of each kind (0-based, with
+// coordinates) and how many there are.
+std::string non_convex_corners_problem(const QuadSurface& surface);
 
 }  // namespace hexbite

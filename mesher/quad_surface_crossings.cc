@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <iterator>
 
-#include "mesher/vec3.h"
+#include "mesher/quad_check.h"
 
 namespace hexbite {
 
@@ -42,7 +42,7 @@ std::vector<std::array<int, 2>> crossings_split_at(const QuadSurface& surface, i
   CGAL::Polygon_mesh_processing::self_intersections(mesh, std::back_inserter(pairs));
   std::vector<std::array<int, 2>> quads;
   for (const auto& [f, g] : pairs) {
-    if (f == g) continue;  // a degenerate triangle (collinear corners: collinear_corners_problem's case)
+    if (f == g) continue;  // a degenerate triangle (collinear corners: non_convex_corners_problem's case)
     const int p = quad_of_face[f.idx()], q = quad_of_face[g.idx()];
     quads.push_back({std::min(p, q), std::max(p, q)});
   }
@@ -50,12 +50,6 @@ std::vector<std::array<int, 2>> crossings_split_at(const QuadSurface& surface, i
   quads.erase(std::unique(quads.begin(), quads.end()), quads.end());
   ok = true;
   return quads;
-}
-
-Vec3 quad_centre(const QuadSurface& surface, int q) {
-  Vec3 c{0, 0, 0};
-  for (int v : surface.quads[static_cast<std::size_t>(q)]) c = vec3::add(c, surface.vertices[v]);
-  return vec3::scale(c, 0.25);
 }
 
 }  // namespace

@@ -71,6 +71,7 @@ QuadSurface read_obj(const std::string& path) {
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1) line = std::string(without_utf8_bom(line));
     if (!line.empty() && line.back() == '\r') line.pop_back();
     line = line.substr(0, line.find('#'));  // a comment, also at the end of a line, as for triangle OBJ
     std::istringstream tokens(line);
@@ -279,10 +280,16 @@ void require_complete_legacy_sections(const std::string& path) {
       if (value.empty()) throw cut_off();
       long long integer = 0;
       double real = 0;
-      if (!(integers ? number(value, integer) : number(value, real)))
+      if (!(integers ? number(value, integer) : parse_double(value, real)))
         throw InputError(quoted(path) + " line " + std::to_string(line) + ": '" + value + "' in its " +
                          section + " section is not " + (integers ? "an integer" : "a number") +
                          "; fix the file or export it again");
+      // VTK's reader stops on these with "Unrecognized keyword" and no line.
+      if (!integers && !std::isfinite(real))
+        throw InputError(quoted(path) + " line " + std::to_string(line) + ": '" + value + "' in its " +
+                         section +
+                         " section is NaN, infinite or beyond the double range; every coordinate must be a "
+                         "finite number");
       // VTK reads a 32-bit type's value into an int, and one beyond it crashed the reader.
       if (integers && legacy_type_size(type) == 4 &&
           (integer < std::numeric_limits<std::int32_t>::min() ||

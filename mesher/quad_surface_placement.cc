@@ -1332,12 +1332,25 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
   // wrong unit would be warped to a tenth of a millimetre or a metre, and its relaxation can then run for
   // minutes. (The grid method meshes any size.)
   if (const double extent = largest_extent(surface); extent < 30.0 || extent > 300.0) {
-    char size[64];
-    std::snprintf(size, sizeof size, "%.4g mm", extent);
-    throw InputError(std::string("the surface is ") + size +
-                     " across (the largest side of its bounding box), but the mandible template places on "
-                     "mandibles 30 to 300 mm across: check the unit (" +
-                     options.terms.units + "), or use " + options.terms.grid_method);
+    const InputTerms& terms = options.terms;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the surface is %.4g mm across (the largest side of its bounding box) with its coordinates "
+                  "read as %s, but the mandible template places on mandibles 30 to 300 mm across: ",
+                  extent, terms.surface_unit.c_str());
+    // The unit that gives a mandible's size, as the size warnings name it (a file in mm read as cm is ten
+    // times too large, and "--units m or cm" pointed the wrong way).
+    const std::string unit = unit_for_size(extent, terms.surface_unit, 30.0, 300.0);
+    std::string fix = "no unit of mm, cm or m gives such a size: scale the file to millimetres first";
+    if (!unit.empty()) {
+      char size[64];
+      std::snprintf(size, sizeof size, "%.4g mm",
+                    extent / stated_unit_to_mm(terms.surface_unit) * unit_to_mm(unit));
+      fix = "if the file's coordinates are in " + unit + " (" + size + " across), " + terms.units;
+      for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
+        fix.replace(at, 6, unit);
+    }
+    throw InputError(text + fix + "; or use " + terms.grid_method);
   }
   MandibleQuadReport report;
   Progress progress("quad surface");

@@ -280,8 +280,7 @@ TriSurface read_stl(const std::string& path) {
   // word "solid" at the start, decides: binary exporters often begin their header with "solid" too.
   if (bytes.size() >= 84 && bytes.size() == 84 + 50 * std::uint64_t(get_u32(bytes, 80)))
     return read_binary_stl(path, bytes);
-  // Some editors start a text file with a UTF-8 byte order mark.
-  const std::string text = bytes.rfind("\xEF\xBB\xBF", 0) == 0 ? bytes.substr(3) : bytes;
+  const std::string text(without_utf8_bom(bytes));
   if (looks_like_ascii_stl(text)) return read_ascii_stl(path, text);
   // Text that is no ASCII STL was called a corrupt binary STL announcing some billion triangles.
   if (is_text(text)) {
@@ -328,7 +327,7 @@ bool is_other_obj_statement(std::string_view key) {
 TriSurface read_obj(const std::string& path) {
   const std::string bytes = read_bytes(path);
   TriSurface s;
-  LineReader lines(bytes);
+  LineReader lines(without_utf8_bom(bytes));
   std::vector<std::string_view> tok;
   std::vector<int> corners;
   // Positive indices may (in lenient exporters) refer to vertices defined further down: they are

@@ -20,6 +20,19 @@ double stated_unit_to_mm(const std::string& unit) {
   return unit.empty() ? 1.0 : unit_to_mm(unit);
 }
 
+std::string unit_for_size(double largest_extent_mm, const std::string& unit, double lo, double hi) {
+  const double in_file_units = largest_extent_mm / stated_unit_to_mm(unit);
+  std::string best;
+  double best_size = 0;
+  for (const char* candidate : {"mm", "cm", "m"}) {
+    const double size = in_file_units * unit_to_mm(candidate);
+    if (size < lo || size > hi) continue;
+    if (best.empty() || std::abs(std::log(size / 100.0)) < std::abs(std::log(best_size / 100.0)))
+      best = candidate, best_size = size;
+  }
+  return best;
+}
+
 namespace {
 
 // The shared sentence of the two size warnings: the size as read, and the unit among mm, cm and m whose
@@ -30,15 +43,7 @@ namespace {
 std::string size_warning(double largest_extent_mm, const std::string& unit, double lo, double hi,
                          bool say_only, const std::string& how, const std::string& what) {
   if (!(largest_extent_mm < lo || largest_extent_mm > hi)) return {};
-  const double in_file_units = largest_extent_mm / stated_unit_to_mm(unit);
-  std::string best;
-  double best_size = 0;
-  for (const char* candidate : {"mm", "cm", "m"}) {
-    const double size = in_file_units * unit_to_mm(candidate);
-    if (size < lo || size > hi) continue;
-    if (best.empty() || std::abs(std::log(size / 100.0)) < std::abs(std::log(best_size / 100.0)))
-      best = candidate, best_size = size;
-  }
+  const std::string best = unit_for_size(largest_extent_mm, unit, lo, hi);
   char text[400];
   std::snprintf(text, sizeof text,
                 "the %s is %s%.4g mm across (the largest side of its bounding box) with its coordinates "
@@ -56,7 +61,7 @@ std::string size_warning(double largest_extent_mm, const std::string& unit, doub
   for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
     fix.replace(at, 6, best);
   char size[64];
-  std::snprintf(size, sizeof size, "%.4g mm", best_size);
+  std::snprintf(size, sizeof size, "%.4g mm", largest_extent_mm / stated_unit_to_mm(unit) * unit_to_mm(best));
   return std::string(text) + ". If the file's coordinates are in " + best + " (" + size + " across), " + fix;
 }
 

@@ -529,6 +529,18 @@ TEST(CliBadInput, NonFiniteNumbersAreRefused) {
        "--refine-at 'nan,0,0' is not a point: X, Y and Z must be finite numbers in mm"},
       {{"mesh", cube, "--method", "sheets", "--refine-at", "0,inf,0", "-o", dir + "/m.vtu"},
        "--refine-at '0,inf,0' is not a point"},
+      // CLI::Range said "Value abc not in range 1.000000 to 30.000000", and something else of nan.
+      {{"mesh", cube, "--method", "sheets", "--refine-at", "0,0,0", "--refine-radius", "abc", "-o",
+        dir + "/m.vtu"},
+       "--refine-radius: abc is not a number: give a number from 1 to 30 (mm)"},
+      {{"mesh", cube, "--method", "sheets", "--refine-at", "0,0,0", "--refine-radius", "nan", "-o",
+        dir + "/m.vtu"},
+       "--refine-radius: nan is out of range: give a number from 1 to 30 (mm)"},
+      {{"quad", "from-mandible", cube, "--refine-at", "0,0,0", "--refine-radius", "40", "-o", dir + "/q.obj"},
+       "--refine-radius: 40 is out of range: give a number from 1 to 30 (mm)"},
+      {{"quad", "from-mandible", cube, "--refine-at", "0,0,0", "--refine-radius", "inf", "-o",
+        dir + "/q.obj"},
+       "--refine-radius: inf is out of range"},
   };
   for (const Case& c : cases) {
     const auto r = run_hexbite(c.args);
@@ -589,6 +601,35 @@ TEST(CliBadInput, SheetsTargetBeyondTheTemplateIsNamedInHexes) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("the mandible template places on mandibles 30 to 300 mm across"), std::string::npos)
       << r.err;
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+// A surface too large for the mandible template was told "check the unit (--units m or cm)" also when read
+// in cm, where mm gives a mandible's size, and `quad from-mandible`, which has no --method, to "use --method
+// grid".
+TEST(CliBadInput, SheetsSizeAdviceNamesTheUnitThatFits) {
+  const std::string dir = temp_dir();
+  const std::string cube = write_case("cube50.obj", cube_obj_of_side(50));
+  const auto mesh = run_hexbite({"mesh", cube, "--method", "sheets", "--units", "cm", "-o", dir + "/m.vtu"});
+  EXPECT_EQ(mesh.exit_code, 2) << mesh.err;
+  EXPECT_NE(
+      mesh.err.find("the surface is 500 mm across (the largest side of its bounding box) with its "
+                    "coordinates read as cm, but the mandible template places on mandibles 30 to 300 mm "
+                    "across: if the file's coordinates are in mm (50 mm across), give --units mm; or use "
+                    "--method grid"),
+      std::string::npos)
+      << mesh.err;
+  const auto quad = run_hexbite({"quad", "from-mandible", cube, "--units", "cm", "-o", dir + "/q.obj"});
+  EXPECT_EQ(quad.exit_code, 2) << quad.err;
+  EXPECT_NE(quad.err.find("give --units mm; or use hexbite mesh --method grid"), std::string::npos)
+      << quad.err;
+  // In mm a 5 m cube fits no unit.
+  const auto big = run_hexbite(
+      {"quad", "from-mandible", write_case("cube5000.obj", cube_obj_of_side(5000)), "-o", dir + "/q.obj"});
+  EXPECT_EQ(big.exit_code, 2) << big.err;
+  EXPECT_NE(big.err.find("no unit of mm, cm or m gives such a size: scale the file to millimetres first"),
+            std::string::npos)
+      << big.err;
   EXPECT_TRUE(fs::is_empty(dir));
 }
 

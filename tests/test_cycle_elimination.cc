@@ -519,7 +519,8 @@ TEST(CycleElimination, CollinearQuadCornersAreAnInputError) {
 // single quad), the RunError still names the chords, says what was tried and ends with the advice; with
 // decomposition off it is the elimination's own message.
 TEST(CycleElimination, FailedDecompositionIsARunError) {
-  const QuadSurface s = test::no_scheme_surface();
+  // The convex version: collinear quad corners are refused before the elimination.
+  const QuadSurface s = test::no_scheme_convex_surface();
   SheetMeshOptions options;
   options.decomposition.max_cycle_length = 4;
   try {

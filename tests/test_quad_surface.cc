@@ -288,6 +288,66 @@ TEST(QuadSurfaceIo, CutOffLegacyVtkIsRefusedNotACrash) {
   EXPECT_NE(e.find("the file ends inside its POLYGONS section"), std::string::npos) << e;
 }
 
+// A NaN, infinite or too large coordinate in a legacy VTK file got VTK's "Unrecognized keyword: nan" (or
+// ": 1" for 1e400) without a line; an OBJ coordinate below the double range (1e-400) was "NaN or infinite";
+// and an OBJ behind a UTF-8 byte order mark was an "unknown OBJ line" showing the invisible mark.
+TEST(QuadSurfaceIo, NonFiniteUnderflowAndByteOrderMark) {
+  const std::string dir = test::temp_dir();
+  const std::string head = "# vtk DataFile Version 3.0\ncube\nASCII\nDATASET POLYDATA\nPOINTS 8 double\n";
+  const std::string tail =
+      "\nPOLYGONS 6 30\n4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+  const std::string points = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n";
+  for (const std::string bad : {"nan", "inf", "1e400"}) {
+    test::write_file(dir + "/c.vtk", head + points + bad + " 1 1" + tail);
+    try {
+      read_quad_surface(dir + "/c.vtk");
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("c.vtk' line 13: '" + bad +
+                                           "' in its POINTS section is NaN, infinite or beyond the double "
+                                           "range; every coordinate must be a finite number"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  std::string obj = "\xEF\xBB\xBF";
+  const QuadSurface cube = test::block_surface(1, 1, 1);
+  for (const Vec3& p : cube.vertices)
+    obj +=
+        "v " + std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + (p[2] == 0 ? "1e-400" : "1") + "\n";
+  for (const auto& q : cube.quads)
+    obj += "f " + std::to_string(q[0] + 1) + " " + std::to_string(q[1] + 1) + " " + std::to_string(q[2] + 1) +
+           " " + std::to_string(q[3] + 1) + "\n";
+  test::write_file(dir + "/bom.obj", obj);
+  const QuadSurface read = read_quad_surface(dir + "/bom.obj");
+  EXPECT_EQ(read.quads, cube.quads);
+  EXPECT_EQ(read.vertices, cube.vertices);
+}
+
+// A quad surface in metres is meshed in its own coordinates, read as mm: `mesh --quad-surface` (whose .inp
+// says mm) and `quad check` warned of nothing, as the readers of hex meshes do.
+TEST(QuadCheckCli, SizeOfNoBoneIsWarnedAbout) {
+  const std::string dir = test::temp_dir();
+  QuadSurface small = test::block_surface(2, 1, 1);
+  for (Vec3& v : small.vertices) v = {v[0] * 0.002, v[1] * 0.002, v[2] * 0.002};
+  write_quad_obj(dir + "/m.obj", small);
+  const std::string warning = "hexbite: warning: '" + dir +
+                              "/m.obj': the quad surface is only 0.004 mm across (the largest side of its "
+                              "bounding box) with its coordinates read as mm";
+  const auto check = test::run_hexbite({"quad", "check", dir + "/m.obj"});
+  EXPECT_EQ(check.exit_code, 0) << check.err;
+  EXPECT_NE(check.err.find(warning), std::string::npos) << check.err;
+  const auto mesh = test::run_hexbite(
+      {"mesh", "--method", "sheets", "--quad-surface", dir + "/m.obj", "-o", dir + "/m.inp"});
+  EXPECT_EQ(mesh.exit_code, 0) << mesh.err;
+  EXPECT_NE(mesh.err.find(warning), std::string::npos) << mesh.err;
+  EXPECT_NE(
+      mesh.err.find("If the file's coordinates are in m (4 mm across), scale the quad surface from m to "
+                    "millimetres where it was made: quad surface files are read in mm"),
+      std::string::npos)
+      << mesh.err;
+}
+
 // A cut-off XML file: VTK's reader reports it only by printing, and that explanation is the error's reason.
 TEST(QuadSurfaceIo, CutOffVtpGivesVtksReason) {
   const std::string dir = test::temp_dir();
@@ -383,6 +443,100 @@ QuadSurface flat_corner_surface() {
   for (Vec3& v : s.vertices)
     if (v == Vec3{1, 0, 0}) v = {0.5, 0, 0.5};
   return s;
+}
+
+// A 2 x 2 x 2 box whose top centre vertex is moved within the top face towards the corner (0, 0, 2): at
+// (0.5, 0.5, 2) the quad over [0, 1]^2 has three collinear corners, nearer the corner it has a reflex one.
+QuadSurface reflex_corner_surface(double at) {
+  QuadSurface s = test::block_surface(2, 2, 2);
+  for (Vec3& v : s.vertices)
+    if (v == Vec3{1, 1, 2}) v = {at, at, 2};
+  return s;
+}
+
+// A reflex corner passed `quad check` ("usable: yes"), and `mesh` then ran the whole elimination and
+// embedding to fail with an inverted hex (exit 1). Bent quads whose corners are convex seen along their
+// normal (a sphere's, a raised vertex's) pass.
+TEST(QuadCheck, ReflexCornersAreNamedBentQuadsPass) {
+  const std::string reflex = non_convex_corners_problem(reflex_corner_surface(0.45));
+  EXPECT_NE(reflex.find("is not convex: its corner at vertex "), std::string::npos) << reflex;
+  EXPECT_NE(reflex.find(" at (0.45, 0.45, 2) between corners "), std::string::npos) << reflex;
+  EXPECT_NE(reflex.find(" is reflex (191 degrees inside): every hex on it has a negative corner Jacobian"),
+            std::string::npos)
+      << reflex;
+  EXPECT_EQ(reflex.find("collinear"), std::string::npos) << reflex;
+  EXPECT_NE(non_convex_corners_problem(reflex_corner_surface(0.5)).find("has three collinear corners"),
+            std::string::npos);
+  EXPECT_EQ(non_convex_corners_problem(reflex_corner_surface(0.55)), "");
+  QuadSurface raised = test::block_surface(2, 2, 2);
+  for (Vec3& v : raised.vertices)
+    if (v == Vec3{1, 1, 2}) v = {1, 1, 3.5};
+  EXPECT_EQ(non_convex_corners_problem(raised), "");
+  EXPECT_EQ(non_convex_corners_problem(test::sphere_surface(4)), "");
+  EXPECT_EQ(non_convex_corners_problem(test::perturbed(test::block_surface(3, 2, 2), 0.1)), "");
+  // Either orientation: the normal turns with the corners.
+  QuadSurface inward = reflex_corner_surface(0.45);
+  for (auto& q : inward.quads) std::reverse(q.begin(), q.end());
+  EXPECT_NE(non_convex_corners_problem(inward).find("(191 degrees inside)"), std::string::npos);
+}
+
+TEST(QuadCheckCli, ReflexCornerIsRefusedBeforeTheWork) {
+  const std::string dir = test::temp_dir();
+  write_quad_obj(dir + "/r045.obj", reflex_corner_surface(0.45));
+  const auto check = test::run_hexbite({"quad", "check", dir + "/r045.obj"});
+  EXPECT_EQ(check.exit_code, 2) << check.err;
+  EXPECT_NE(check.err.find("is reflex (191 degrees inside)"), std::string::npos) << check.err;
+  EXPECT_NE(check.out.find("usable for --method sheets: no"), std::string::npos) << check.out;
+  for (const char* extra : {"--json", "--allow-invalid"}) {
+    const auto mesh = test::run_hexbite(
+        {"mesh", "--method", "sheets", "--quad-surface", dir + "/r045.obj", "-o", dir + "/m.vtu", extra});
+    EXPECT_EQ(mesh.exit_code, 2) << mesh.err;
+    EXPECT_NE(mesh.err.find("is reflex (191 degrees inside)"), std::string::npos) << mesh.err;
+    EXPECT_EQ(mesh.out.find("Meshed"), std::string::npos) << mesh.out;  // before the elimination
+    EXPECT_EQ(mesh.out.find("eliminations"), std::string::npos) << mesh.out;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/m.vtu"));
+  }
+}
+
+// Two quads sharing two edges were counted ("2 pairs of quads share two or more edges, 0 duplicate quads")
+// but not named, the cut vertices of the graph were named by no problem although "3-connected no", and
+// a repeated quad was reported only as a non-manifold edge.
+TEST(QuadCheck, NonSimpleGraphsNameTheirQuads) {
+  // A cube whose top and bottom are each split by a vertex of degree 2 on their diagonal.
+  QuadSurface split;
+  split.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},       {0, 0, 1},
+                    {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, {0.5, 0.5, 1.3}, {0.5, 0.5, -0.3}};
+  split.quads = {{0, 3, 2, 9}, {0, 9, 2, 1}, {4, 5, 6, 8}, {4, 8, 6, 7},
+                 {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  const QuadSurfaceReport r = check_quad_surface(split, "split");
+  EXPECT_EQ(r.quad_pairs_sharing_edges, 2);
+  const auto has = [&](const QuadSurfaceReport& report, const std::string& text) {
+    for (const std::string& p : report.problems)
+      if (p.find(text) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(
+      has(r,
+          "graph not simple: 2 pairs of quads share two or more edges (the first: quad 0 (vertices "
+          "0, 3, 2, 9; centre (0.375, 0.625, -0.075)) and quad 1 (vertices 0, 9, 2, 1; centre (0.625, "
+          "0.375, -0.075)) share edges 0-9, 2-9)"))
+      << r.problems.size();
+  // The top's vertex of degree 2 (vertex 8) is found first: its two neighbours separate it.
+  EXPECT_TRUE(has(r,
+                  "graph not 3-connected: removing vertex 4 at (0, 0, 1) and vertex 6 at (1, 1, 1) "
+                  "disconnects it"));
+  EXPECT_FALSE(has(r, "duplicate"));
+
+  QuadSurface twice = test::block_surface(1, 1, 1);
+  twice.quads.push_back(twice.quads[3]);
+  twice.quads.push_back(twice.quads[3]);
+  const QuadSurfaceReport d = check_quad_surface(twice, "twice");
+  EXPECT_EQ(d.duplicate_quads, 2);
+  EXPECT_TRUE(has(d,
+                  "graph not simple: 2 duplicate quads (the same vertices as an earlier quad; the first: "
+                  "quad 6 (vertices "));
+  EXPECT_TRUE(has(d, ", the same as quad 3); remove the repeated quads"));
+  EXPECT_TRUE(has(d, "not manifold: "));
 }
 
 TEST(QuadCheckCli, ExitCodesAndMessages) {
@@ -506,25 +660,27 @@ TEST(MeshSheetsCli, FoldedQuadSurfaceIsRefusedFirst) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/fold.vtu"));
 }
 
-// A 2 x 2 x 1 box whose top centre vertex is moved within the top face next to a corner: one top quad is
-// non-convex (a reflex corner), the surface does not cross itself, and every hex on that quad is inverted at
-// the reflex corner. The message named no hex, and the quality line printed "nan" for the condition
-// numbers it could not take.
+// A 2 x 2 x 1 box whose top centre vertex is pulled down next to the bottom corner (2, 2, 0): the top quads
+// are bent but convex seen along their normals (a reflex corner is refused before the work), the surface
+// does not cross itself, and one hex stays inverted. The message named no hex, and the quality line printed
+// "nan" for the condition numbers it could not take.
 TEST(MeshSheetsCli, InvertedHexesAreNamedWithTheirPlaces) {
-  QuadSurface dart = test::block_surface(2, 2, 1);
-  for (Vec3& v : dart.vertices)
-    if (v[0] == 1 && v[1] == 1 && v[2] == 1) v = {0.1, 0.1, 1};
-  ASSERT_TRUE(crossing_quads(dart).empty());
+  QuadSurface bent = test::block_surface(2, 2, 1);
+  for (Vec3& v : bent.vertices)
+    if (v[0] == 1 && v[1] == 1 && v[2] == 1) v = {1.9, 1.9, 0.05};
+  ASSERT_TRUE(crossing_quads(bent).empty());
+  ASSERT_EQ(non_convex_corners_problem(bent), "");
   const std::string dir = test::temp_dir();
-  write_quad_obj(dir + "/dart.obj", dart);
+  write_quad_obj(dir + "/dart.obj", bent);
   const auto r = test::run_hexbite(
       {"mesh", "--quad-surface", dir + "/dart.obj", "--method", "sheets", "-o", dir + "/dart.vtu"});
   EXPECT_EQ(r.exit_code, 1) << r.err;
   // One hex, so "1 hex stays" ("1 hexes stay" before).
-  EXPECT_NE(r.err.find("failed: 1 hex stays inverted after optimization: hex 2 at ("), std::string::npos)
+  EXPECT_NE(r.err.find("failed: 1 hex stays inverted after optimization: hex 0 at ("), std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find(") mm"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("may be reflex"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the quads there may be too bent for the hexes under them"), std::string::npos)
+      << r.err;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir + "/dart.vtu"));
 }

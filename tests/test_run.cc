@@ -971,7 +971,8 @@ TEST(RunScenario, SheetsMethodOnAnotherSolidAdvisesTheScenariosKeys) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(dir + "/cube.yaml:4:"), std::string::npos) << r.err;  // the line of `method`
   EXPECT_NE(r.err.find("the surface is 20 mm across"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("check the unit (units: m or cm in geometry.surface), or use method: grid"),
+  EXPECT_NE(r.err.find("if the file's coordinates are in cm (200 mm across), write units: cm in "
+                       "geometry.surface; or use method: grid"),
             std::string::npos)
       << r.err;
   EXPECT_EQ(r.err.find("--"), std::string::npos) << r.err;

@@ -387,6 +387,18 @@ TEST(SurfaceIoErrors, TextThatIsNoStlIsNamedAndAByteOrderMarkIsSkipped) {
   EXPECT_EQ(read_surface(dir + "/bom.stl").triangles.size(), 1u);
 }
 
+// An OBJ behind a UTF-8 byte order mark was refused naming an invisible character glued to its first 'v',
+// and a coordinate below the double range (1e-400) was "NaN or infinite": it is read as 0, as strtod does.
+TEST(SurfaceIo, ObjByteOrderMarkAndUnderflow) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/bom.obj",
+             "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e-400\nv 0 0 1\n"
+             "f 1 3 2\nf 1 2 5\nf 1 5 3\nf 2 3 5\n");
+  const TriSurface s = read_surface(dir + "/bom.obj");
+  EXPECT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.vertices.at(3)[2], 0.0);
+}
+
 // Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
 // infinities (1e40 does not fit a float), `mesh` stopped on a CGAL assertion (1e16).
 TEST(SurfaceIoErrors, CoordinatesBeyondAKilometreAreRefused) {
