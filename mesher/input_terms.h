@@ -15,20 +15,18 @@ struct InputTerms {
   std::string surface_unit = "mm";            // the unit the surface was read in
 };
 
-// The terms of `hexbite quad from-mandible`, which has no --method: the grid mesher is another command.
-inline InputTerms quad_command_terms(const std::string& surface_unit) {
-  return {"hexbite mesh --method grid",
-          "hexbite mesh --method sheets",
-          "--target-hexes",
-          "--landmarks",
-          "give --units <unit>",
-          surface_unit};
-}
-
 // The terms of `hexbite mesh`, reading its surface in `surface_unit`.
 inline InputTerms mesh_command_terms(const std::string& surface_unit) {
   InputTerms terms;
   terms.surface_unit = surface_unit;
+  return terms;
+}
+
+// The terms of `hexbite quad from-mandible`, which has no --method: the meshers are another command.
+inline InputTerms quad_command_terms(const std::string& surface_unit) {
+  InputTerms terms = mesh_command_terms(surface_unit);
+  terms.grid_method = "hexbite mesh --method grid";
+  terms.sheets_method = "hexbite mesh --method sheets";
   return terms;
 }
 
