@@ -1340,17 +1340,12 @@ QuadSurface quad_surface_from_mandible(const TriSurface& surface, const Landmark
                   extent, terms.surface_unit.c_str());
     // The unit that gives a mandible's size, as the size warnings name it (a file in mm read as cm is ten
     // times too large, and "--units m or cm" pointed the wrong way).
-    const std::string unit = unit_for_size(extent, terms.surface_unit, 30.0, 300.0);
-    std::string fix = "no unit of mm, cm or m gives such a size: scale the file to millimetres first";
-    if (!unit.empty()) {
-      char size[64];
-      std::snprintf(size, sizeof size, "%.4g mm",
-                    extent / stated_unit_to_mm(terms.surface_unit) * unit_to_mm(unit));
-      fix = "if the file's coordinates are in " + unit + " (" + size + " across), " + terms.units;
-      for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
-        fix.replace(at, 6, unit);
-    }
-    throw InputError(text + fix + "; or use " + terms.grid_method);
+    const std::string fix = unit_that_fits(extent, terms.surface_unit, 30.0, 300.0, terms.units);
+    throw InputError(text +
+                     (fix.empty()
+                          ? "no unit of mm, cm or m gives such a size: scale the file to millimetres first"
+                          : "if " + fix) +
+                     "; or use " + terms.grid_method);
   }
   MandibleQuadReport report;
   Progress progress("quad surface");

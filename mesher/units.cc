@@ -20,7 +20,8 @@ double stated_unit_to_mm(const std::string& unit) {
   return unit.empty() ? 1.0 : unit_to_mm(unit);
 }
 
-std::string unit_for_size(double largest_extent_mm, const std::string& unit, double lo, double hi) {
+std::string unit_that_fits(double largest_extent_mm, const std::string& unit, double lo, double hi,
+                           const std::string& how) {
   const double in_file_units = largest_extent_mm / stated_unit_to_mm(unit);
   std::string best;
   double best_size = 0;
@@ -30,7 +31,13 @@ std::string unit_for_size(double largest_extent_mm, const std::string& unit, dou
     if (best.empty() || std::abs(std::log(size / 100.0)) < std::abs(std::log(best_size / 100.0)))
       best = candidate, best_size = size;
   }
-  return best;
+  if (best.empty()) return {};
+  std::string fix = how;
+  for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
+    fix.replace(at, 6, best);
+  char size[64];
+  std::snprintf(size, sizeof size, "%.4g mm", best_size);
+  return "the file's coordinates are in " + best + " (" + size + " across), " + fix;
 }
 
 namespace {
@@ -43,26 +50,21 @@ namespace {
 std::string size_warning(double largest_extent_mm, const std::string& unit, double lo, double hi,
                          bool say_only, const std::string& how, const std::string& what) {
   if (!(largest_extent_mm < lo || largest_extent_mm > hi)) return {};
-  const std::string best = unit_for_size(largest_extent_mm, unit, lo, hi);
+  const std::string fix = unit_that_fits(largest_extent_mm, unit, lo, hi, how);
   char text[400];
   std::snprintf(text, sizeof text,
                 "the %s is %s%.4g mm across (the largest side of its bounding box) with its coordinates "
                 "read as %s; a mandible is about 100 mm",
                 what.c_str(), say_only && largest_extent_mm < lo ? "only " : "", largest_extent_mm,
                 unit.c_str());
-  if (best.empty()) {
+  if (fix.empty()) {
     std::snprintf(text + std::strlen(text), sizeof text - std::strlen(text),
                   ", and no unit of mm, cm or m gives a size between %g and %g mm: scale the file to "
                   "millimetres first",
                   lo, hi);
     return text;
   }
-  std::string fix = how;
-  for (std::size_t at = fix.find("<unit>"); at != std::string::npos; at = fix.find("<unit>"))
-    fix.replace(at, 6, best);
-  char size[64];
-  std::snprintf(size, sizeof size, "%.4g mm", largest_extent_mm / stated_unit_to_mm(unit) * unit_to_mm(best));
-  return std::string(text) + ". If the file's coordinates are in " + best + " (" + size + " across), " + fix;
+  return std::string(text) + ". If " + fix;
 }
 
 }  // namespace

@@ -19,9 +19,12 @@ double unit_to_mm(const std::string& unit);
 // micrometres, which no option or key offers) and "" (no unit stated: read as mm).
 double stated_unit_to_mm(const std::string& unit);
 
-// The unit among mm, cm and m in which a file read in `unit` (or um), `largest_extent_mm` across after the
-// conversion, comes nearest 100 mm (by ratio) within [lo, hi] mm; empty when none of them gives such a size.
-std::string unit_for_size(double largest_extent_mm, const std::string& unit, double lo, double hi);
+// For a file read in `unit` (or um), `largest_extent_mm` across after the conversion: the unit among mm, cm
+// and m whose reading comes nearest 100 mm (by ratio) within [lo, hi] mm, as "the file's coordinates are in
+// cm (117.7 mm across), " followed by `how` to give it ("<unit>" in it replaced by the unit); empty when none
+// of them gives such a size.
+std::string unit_that_fits(double largest_extent_mm, const std::string& unit, double lo, double hi,
+                           const std::string& how);
 
 // A sentence for a warning when a bone surface read with its coordinates in `unit` (mm, cm or m) has a size
 // no bone has: its largest side, `largest_extent_mm` after the conversion, under 0.5 mm (a bone exported in
