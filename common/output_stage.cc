@@ -16,6 +16,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/progress.h"
 
 namespace hexbite {
 
@@ -77,20 +78,26 @@ std::map<std::pair<dev_t, ino_t>, HeldFolder> g_held;
 }  // namespace
 
 CommitLock::CommitLock(const std::vector<std::string>& dirs) {
-  std::map<std::pair<dev_t, ino_t>, int> opened;  // sorted: the order every process locks in
+  // Sorted: the order every process locks in. The descriptor and the folder's name as given.
+  std::map<std::pair<dev_t, ino_t>, std::pair<int, std::string>> opened;
   for (const std::string& dir : dirs) {
     const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     struct stat st {};
     if (fd < 0) continue;  // the commit names what is wrong with the folder
-    if (::fstat(fd, &st) != 0 || !opened.emplace(std::make_pair(st.st_dev, st.st_ino), fd).second)
+    if (::fstat(fd, &st) != 0 ||
+        !opened.emplace(std::make_pair(st.st_dev, st.st_ino), std::make_pair(fd, dir)).second)
       ::close(fd);
   }
-  for (const auto& [folder, fd] : opened) {
+  for (const auto& [folder, opened_dir] : opened) {
+    const auto& [fd, dir] = opened_dir;
     HeldFolder& held = g_held[folder];
     if (held.holders++ > 0) {
       ::close(fd);
     } else {
       held.fd = fd;
+      // A wait can be long (the other run stopped with Ctrl-Z): say why nothing happens.
+      if (::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK)
+        info("waiting for another hexbite process to finish writing into '" + dir + "'");
       while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
       }
     }

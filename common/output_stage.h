@@ -82,7 +82,7 @@ class OutputStage {
 };
 
 // While it lives, the folders `dirs` are locked against the CommitLocks of other processes, which wait for
-// it to end, and SIGINT, SIGTERM and SIGHUP wait as well (SignalsDeferred), so that the files moved into
+// it to end (saying so with info(): "waiting for another hexbite process ..."), and SIGINT, SIGTERM and SIGHUP wait as well (SignalsDeferred), so that the files moved into
 // them are one run's set whole. OutputStage::commit() takes one for its folder; a command that commits
 // several stages takes one for all their folders around the commits, so that another run's commits come
 // before or after all of them. Within the process it nests: a folder locked already is not waited for.

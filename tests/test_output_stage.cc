@@ -9,7 +9,9 @@
 #include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -287,7 +289,10 @@ TEST(OutputStage, ACommitWaitsWhileAnotherProcessHoldsItsFolderWithOthers) {
     test::write_file(stage.stage_dir() + "/out_a", "a\n");
     char byte = 0;
     if (read(go[0], &byte, 1) != 1) throw std::runtime_error("no go");
+    std::ofstream said(one + "/said.txt");
+    std::streambuf* const terminal = std::cout.rdbuf(said.rdbuf());
     stage.commit({"out_a"}, is_output);
+    std::cout.rdbuf(terminal);
   });
   {
     const CommitLock locked({one, two});
@@ -301,6 +306,9 @@ TEST(OutputStage, ACommitWaitsWhileAnotherProcessHoldsItsFolderWithOthers) {
   const int status = wait_for(child);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
   EXPECT_EQ(test::read_file(two + "/out_a"), "a\n");
+  // A run held up by another printed nothing, however long the other took (hunt U, noticed).
+  EXPECT_EQ(test::read_file(one + "/said.txt"),
+            "waiting for another hexbite process to finish writing into '" + two + "'\n");
 }
 
 // Ctrl-C, SIGTERM or SIGHUP in the middle of the moves left the new mesh.vtu beside the old solution.vtu
