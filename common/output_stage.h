@@ -82,12 +82,13 @@ class OutputStage {
 };
 
 // While it lives, the folders `dirs` are locked against the CommitLocks of other processes, which wait for
-// it to end (saying so with info(): "waiting for another hexbite process ..."), and SIGINT, SIGTERM and SIGHUP wait as well (SignalsDeferred), so that the files moved into
-// them are one run's set whole. OutputStage::commit() takes one for its folder; a command that commits
-// several stages takes one for all their folders around the commits, so that another run's commits come
-// before or after all of them. Within the process it nests: a folder locked already is not waited for.
-// Every process locks the folders in the same order (of their device and inode), so two never wait for each
-// other. The lock is an flock on the folder; where the file system has none, commits do not wait.
+// it to end (saying so with info(): "waiting for another hexbite process ..."), and SIGINT, SIGTERM and
+// SIGHUP wait as well (SignalsDeferred), so that the files moved into them are one run's set whole.
+// OutputStage::commit() takes one for its folder; a command that commits several stages takes one for all
+// their folders around the commits, so that another run's commits come before or after all of them. Within
+// the process it nests: a folder locked already is not waited for. Every process locks the folders in the
+// same order (of their device and inode), so two never wait for each other. The lock is an flock on the
+// folder; where the file system has none, commits do not wait.
 class CommitLock {
  public:
   explicit CommitLock(const std::vector<std::string>& dirs);
