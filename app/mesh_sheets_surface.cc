@@ -307,8 +307,12 @@ void run_mesh_sheets_surface(const MeshSheetsSurfaceOptions& o) {
     std::cout << out.str();
   }
   if (!sheet_report.boundary_crossings.empty()) {
-    const std::string text =
-        sheet_report.boundary_crossing_text + "; ask for fewer hexes, or use --method grid";
+    // Which quads cross depends on the target either way: the built-in mandible without landmarks crosses
+    // at 1,400-1,500 target hexes and meshes at 1,600-4,000.
+    const std::string text = sheet_report.boundary_crossing_text +
+                             "; try another --target-hexes (more or fewer: which quads cross depends on it)" +
+                             (qo.landmarks.empty() ? ", give the surface's --landmarks L.yaml," : "") +
+                             " or use --method grid";
     if (!o.allow_invalid) throw RunError(text + "; no mesh written (--allow-invalid writes it anyway)");
     std::cerr << "hexbite: warning: wrote " << qo.output << " on purpose (--allow-invalid): " << text << '\n';
   }

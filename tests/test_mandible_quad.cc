@@ -468,6 +468,24 @@ TEST(MandibleQuadsCli, MeshSheetsFromTheGeneratedMandibleIsValid) {
   EXPECT_LT(j["fidelity"]["hausdorff_mm"].get<double>(), 2.9);
 }
 
+// Without landmarks the built-in mandible's slid boundary crosses itself at 1,400-1,500 target hexes (32
+// pairs near the left ramus at 1,450) and meshes at 1,600-4,000: the message said "ask for fewer hexes",
+// which does not help here. It now asks for another target, more or fewer, or the surface's landmarks.
+TEST(MandibleQuadsCli, ASlidBoundaryThatCrossesItselfAsksForAnotherTargetOrTheLandmarks) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(test::run_hexbite({"generate", "mandible", "-o", dir + "/m.stl"}).exit_code, 0);
+  const auto r = test::run_hexbite(
+      {"mesh", dir + "/m.stl", "--method", "sheets", "--target-hexes", "1450", "-o", dir + "/s.vtu", "-q"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("the mesh's boundary, slid on the input, crosses itself: quads "), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("; try another --target-hexes (more or fewer: which quads cross depends on it), give "
+                       "the surface's --landmarks L.yaml, or use --method grid; no mesh written"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/s.vtu"));
+}
+
 // The edentulous variant: the geometric order runs into a dead end after 88 eliminations; before the
 // look-ahead fallback a decomposition along a primal cycle gave 4,157 hexes of SJ 0.247 / 0.805. Now the
 // look-ahead order completes: measured 2,477 hexes, SJ 0.543 / 0.881, no decomposition.
