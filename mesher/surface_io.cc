@@ -394,7 +394,7 @@ TriSurface read_obj(const std::string& path) {
 
 TriSurface read_off(const std::string& path) {
   const std::string bytes = read_bytes(path);
-  LineReader lines(bytes);
+  LineReader lines(without_utf8_bom(bytes));
   std::vector<std::string_view> tok;
   auto next_nonblank = [&](const std::string& expecting) {
     while (lines.next(tok, true))
@@ -521,7 +521,9 @@ double ply_binary_value(const std::string& bytes, std::size_t at, const std::str
 
 TriSurface read_ply(const std::string& path) {
   const std::string bytes = read_bytes(path);
-  LineReader lines(bytes);
+  // The header is read after a UTF-8 byte order mark; binary offsets stay those of the file.
+  const std::size_t bom = bytes.size() - without_utf8_bom(bytes).size();
+  LineReader lines(std::string_view(bytes).substr(bom));
   std::vector<std::string_view> tok;
   auto header_error = [&](const std::string& what) {
     return InputError(quoted(path) + " " + lines.where() + ": " + what +
@@ -608,7 +610,7 @@ TriSurface read_ply(const std::string& path) {
   // The records follow the header line by line (ASCII) or byte by byte (binary). The faces' vertex lists are
   // checked after every element is read: the vertex element usually comes first, but the format allows
   // either order (a face element first was said to refer to vertices "out of range: the file has 0").
-  std::size_t at = std::min(lines.position(), bytes.size());
+  std::size_t at = std::min(bom + lines.position(), bytes.size());
   const bool binary = format != PlyFormat::kAscii;
   const bool big = format == PlyFormat::kBig;
   LineReader body(std::string_view(bytes).substr(at));

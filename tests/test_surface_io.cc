@@ -399,6 +399,24 @@ TEST(SurfaceIo, ObjByteOrderMarkAndUnderflow) {
   EXPECT_EQ(s.vertices.at(3)[2], 0.0);
 }
 
+// OFF and PLY behind a UTF-8 byte order mark were refused ("expected the keyword OFF", "its first line must
+// be 'ply'") where OBJ and STL were read.
+TEST(SurfaceIo, OffAndPlyByteOrderMarkIsSkipped) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/bom.off", "\xEF\xBB\xBFOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(read_surface(dir + "/bom.off").triangles.size(), 1u);
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  write_file(dir + "/bom.ply", "\xEF\xBB\xBF" + header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(read_surface(dir + "/bom.ply").triangles.size(), 1u);
+  // Binary data starts after the header, wherever the mark put it.
+  const std::string path = dir + "/bom_binary.ply";
+  write_surface(path, subdivided_cube(1));
+  write_file(path, "\xEF\xBB\xBF" + read_file(path));
+  EXPECT_EQ(read_surface(path).triangles.size(), 12u);
+}
+
 // Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
 // infinities (1e40 does not fit a float), `mesh` stopped on a CGAL assertion (1e16).
 TEST(SurfaceIoErrors, CoordinatesBeyondAKilometreAreRefused) {
