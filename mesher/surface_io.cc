@@ -21,12 +21,14 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <string_view>
 
@@ -197,8 +199,15 @@ std::string first_word(const std::string& bytes) {
   return bytes.substr(i, end - i);
 }
 
+// Keywords of text formats are compared in lower case: exporters write "SOLID", "Facet", "VERTEX" too.
+std::string lower_case(std::string_view word) {
+  std::string s(word);
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
 bool looks_like_ascii_stl(const std::string& bytes) {
-  return first_word(bytes).rfind("solid", 0) == 0 && is_text(bytes);
+  return lower_case(first_word(bytes)).rfind("solid", 0) == 0 && is_text(bytes);
 }
 
 TriSurface read_binary_stl(const std::string& path, const std::string& bytes) {
@@ -222,6 +231,8 @@ TriSurface read_binary_stl(const std::string& path, const std::string& bytes) {
   return s;
 }
 
+// Read by statements rather than by lines: a line may hold several of them (some exporters write the whole
+// file on one line), and each statement's words are on the line of its keyword.
 TriSurface read_ascii_stl(const std::string& path, const std::string& bytes) {
   TriSurface s;
   LineReader lines(bytes);
@@ -234,38 +245,55 @@ TriSurface read_ascii_stl(const std::string& path, const std::string& bytes) {
                       "': expected " + expected + "; fix the line or export the surface again");
   };
   while (lines.next(tok, false)) {
-    if (tok.empty()) continue;
-    const std::string_view key = tok[0];
-    if (key == "solid" || key == "endsolid") {
-      if (in_facet) throw malformed("'endfacet' before '" + std::string(key) + "'");
-    } else if (key == "facet") {
-      if (in_facet) throw malformed("'endfacet' before the next facet");
-      in_facet = true;
-      facet_line = lines.line();
-    } else if (key == "outer") {
-      if (!in_facet || in_loop || tok.size() != 2 || tok[1] != "loop")
-        throw malformed("'outer loop' directly after 'facet normal nx ny nz'");
-      in_loop = true;
-      loop.clear();
-    } else if (key == "vertex") {
-      if (!in_loop) throw malformed("'vertex' only between 'outer loop' and 'endloop'");
-      Vec3 p;
-      if (tok.size() != 4 || !parse_point(tok, 1, p)) throw malformed("'vertex x y z' with three numbers");
-      require_finite(path, lines.where(), p);
-      loop.push_back(static_cast<int>(s.vertices.size()));
-      s.vertices.push_back(p);
-    } else if (key == "endloop") {
-      if (!in_loop) throw malformed("'endloop' only after 'outer loop'");
-      if (loop.size() < 3)
-        throw malformed("at least three 'vertex' lines in the facet starting at line " +
-                        std::to_string(facet_line));
-      add_fanned(s, loop);
-      in_loop = false;
-    } else if (key == "endfacet") {
-      if (!in_facet || in_loop) throw malformed("'endloop' before 'endfacet'");
-      in_facet = false;
-    } else {
-      throw malformed("an STL keyword (solid, facet, outer loop, vertex, endloop, endfacet, endsolid)");
+    std::size_t i = 0;  // the next word of the line
+    // Skips the words up to the next one of `stops` on this line: a solid's name, a facet's normal.
+    auto skip_to = [&](std::initializer_list<const char*> stops) {
+      while (i < tok.size() &&
+             std::none_of(stops.begin(), stops.end(), [&](const char* k) { return lower_case(tok[i]) == k; }))
+        ++i;
+    };
+    while (i < tok.size()) {
+      const std::string key = lower_case(tok[i++]);
+      if (key == "solid" || key == "endsolid") {
+        if (in_facet) throw malformed("'endfacet' before '" + std::string(tok[i - 1]) + "'");
+        if (key == "solid")
+          skip_to({"facet", "endsolid"});
+        else
+          skip_to({"solid"});
+      } else if (key == "facet") {
+        if (in_facet) throw malformed("'endfacet' before the next facet");
+        in_facet = true;
+        facet_line = lines.line();
+        skip_to({"outer"});  // the normal is recomputed from the corners
+      } else if (key == "outer") {
+        if (!in_facet || in_loop || i == tok.size() || lower_case(tok[i]) != "loop")
+          throw malformed("'outer loop' directly after 'facet normal nx ny nz'");
+        ++i;
+        in_loop = true;
+        loop.clear();
+      } else if (key == "vertex") {
+        if (!in_loop) throw malformed("'vertex' only between 'outer loop' and 'endloop'");
+        Vec3 p;
+        double extra = 0.0;
+        if (!parse_point(tok, i, p) || (i + 3 < tok.size() && parse_double(tok[i + 3], extra)))
+          throw malformed("'vertex x y z' with three numbers");
+        i += 3;
+        require_finite(path, lines.where(), p);
+        loop.push_back(static_cast<int>(s.vertices.size()));
+        s.vertices.push_back(p);
+      } else if (key == "endloop") {
+        if (!in_loop) throw malformed("'endloop' only after 'outer loop'");
+        if (loop.size() < 3)
+          throw malformed("at least three 'vertex' lines in the facet starting at line " +
+                          std::to_string(facet_line));
+        add_fanned(s, loop);
+        in_loop = false;
+      } else if (key == "endfacet") {
+        if (!in_facet || in_loop) throw malformed("'endloop' before 'endfacet'");
+        in_facet = false;
+      } else {
+        throw malformed("an STL keyword (solid, facet, outer loop, vertex, endloop, endfacet, endsolid)");
+      }
     }
   }
   if (in_facet)

@@ -214,6 +214,32 @@ TEST(SurfaceIo, AsciiStl) {
   expect_same_geometry(cube, read_surface(named), named);
 }
 
+// Keywords in upper case were "text that does not begin with 'solid'"; a file with all of it on one line
+// "contains no triangles" (everything was the solid's name).
+TEST(SurfaceIo, AsciiStlKeywordsInAnyCaseAndStatementsOnOneLine) {
+  const std::string facet =
+      "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+  std::string upper = "SOLID PART\n" + facet + "ENDSOLID PART\n";
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
+  const std::string dir = temp_dir();
+  write_file(dir + "/upper.stl", upper);
+  TriSurface s = read_surface(dir + "/upper.stl");
+  ASSERT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(s.vertices[1], (Vec3{1, 0, 0}));
+
+  std::string one_line = "solid my part " + facet + facet + "endsolid my part";
+  std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+  write_file(dir + "/one_line.stl", one_line + "\n");
+  s = read_surface(dir + "/one_line.stl");
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.vertices[5], (Vec3{0, 1, 0}));
+  // A number too many is still named, on one line as on several.
+  one_line.replace(one_line.find("vertex 1 0 0"), 12, "vertex 1 0 0 7");
+  write_file(dir + "/four.stl", one_line + "\n");
+  expect_input_error([&] { read_surface(dir + "/four.stl"); },
+                     {"line 1", "expected 'vertex x y z' with three numbers"});
+}
+
 // Unit cube corners: vertex i has x = bit 0, y = bit 1, z = bit 2; faces as outward quads.
 const char* const kCubeVertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n";
 
