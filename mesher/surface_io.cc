@@ -417,8 +417,10 @@ TriSurface read_obj(const std::string& path) {
 }
 
 // ------------------------------------------------------------------------------------------------
-// OFF: header keyword (OFF, COFF, NOFF, CNOFF, STOFF, ...), counts "nv nf ne", nv vertex lines
-// "x y z [extras]", nf face lines "k i_1 .. i_k [colour]" with 0-based indices; '#' starts a comment.
+// OFF: header keyword (OFF, COFF, NOFF, CNOFF, STOFF, ...), counts "nv nf ne", nv vertices
+// "x y z [nx ny nz] [r g b [a]] [s t]" (the header's N, C and ST say which follow the coordinates), nf face
+// lines "k i_1 .. i_k [colour]" with 0-based indices; '#' starts a comment. OFF is whitespace-delimited, so
+// without colours (whose count varies) a line may hold several vertices; each lies on one line.
 
 TriSurface read_off(const std::string& path) {
   const std::string bytes = read_bytes(path);
@@ -440,6 +442,13 @@ TriSurface read_off(const std::string& path) {
   const bool keyword_ok = keyword.size() >= 3 && keyword.substr(keyword.size() - 3) == "OFF" &&
                           keyword.find_first_not_of("STCN") == keyword.size() - 3;
   if (!keyword_ok) throw malformed("the keyword OFF (or COFF, NOFF, CNOFF, STOFF) on the first line");
+  const std::string_view prefix = keyword.substr(0, keyword.size() - 3);
+  const bool normals = prefix.find('N') != std::string_view::npos,
+             colours = prefix.find('C') != std::string_view::npos,
+             texture = prefix.find("ST") != std::string_view::npos;
+  const std::size_t per_vertex = 3 + (normals ? 3 : 0) + (texture ? 2 : 0);
+  const std::string vertex_form = std::string("'x y z") + (normals ? " nx ny nz" : "") +
+                                  (colours ? " r g b [a]" : "") + (texture ? " s t" : "") + "'";
   std::size_t first_count = 1;
   if (tok.size() == 1) {
     next_nonblank("the counts 'vertices faces edges'");
@@ -454,19 +463,41 @@ TriSurface read_off(const std::string& path) {
   // The count is the file's word: a damaged header ("2000000000 1 0") must not reserve more than the file
   // can hold (a vertex line takes at least 6 bytes), or it ends in std::bad_alloc instead of "cut off".
   s.vertices.reserve(std::min(static_cast<std::size_t>(nv), bytes.size() / 6));
+  std::size_t next = tok.size();  // the next value of the current line
   for (long long i = 0; i < nv; ++i) {
-    next_nonblank("vertex " + std::to_string(i) + " of " + std::to_string(nv));
+    if (next == tok.size()) {
+      next_nonblank("vertex " + std::to_string(i) + " of " + std::to_string(nv));
+      next = 0;
+    }
+    auto vertex = [&] { return "vertex " + std::to_string(i) + " as " + vertex_form; };
+    if (colours && (tok.size() < per_vertex || tok.size() > per_vertex + 4))
+      throw malformed(vertex() + ", one vertex per line (the line has " + std::to_string(tok.size()) +
+                      " values)");
+    if (!colours && tok.size() - next < per_vertex)
+      throw malformed(vertex() + ": the line's " + std::to_string(tok.size()) +
+                      " values are not whole vertices of " + std::to_string(per_vertex) +
+                      " values each (vertex colours need a COFF header)");
     Vec3 p;
-    if (!parse_point(tok, 0, p)) throw malformed("vertex " + std::to_string(i) + " as 'x y z'");
+    if (!parse_point(tok, next, p)) throw malformed(vertex());
     require_finite(path, lines.where() + " (vertex " + std::to_string(i) + ", 0-based)", p);
     s.vertices.push_back(p);
+    next = colours ? tok.size() : next + per_vertex;
   }
+  if (next < tok.size())
+    throw malformed("no more values after vertex " + std::to_string(nv - 1) + ", the last of the " +
+                    std::to_string(nv) + " the header announces (the faces follow, one per line)");
   std::vector<int> corners;
   for (long long f = 0; f < nf; ++f) {
     next_nonblank("face " + std::to_string(f) + " of " + std::to_string(nf));
     long long k = 0;
     if (!parse_integer(tok[0], k) || k < 3 || tok.size() < std::size_t(k) + 1)
       throw malformed("face " + std::to_string(f) + " as 'k i_1 ... i_k' with k >= 3 vertex indices");
+    // A colour is at most 4 values; more is a second face on the line, or a wrong k.
+    if (tok.size() > std::size_t(k) + 5)
+      throw malformed("face " + std::to_string(f) +
+                      " as 'k i_1 ... i_k [colour]' on a line of its own: after its " + std::to_string(k) +
+                      " indices come " + std::to_string(tok.size() - std::size_t(k) - 1) +
+                      " values, more than a colour's 4");
     corners.clear();
     for (long long i = 1; i <= k; ++i) {
       long long index = 0;
@@ -647,6 +678,10 @@ TriSurface read_ply(const std::string& path) {
   std::vector<long long> list;
   std::vector<long long> face_indices;  // every face's list, one after another
   std::vector<std::size_t> face_ends;   // where each face's list ends in face_indices
+  // ASCII records are read by values, as the header declares them: a line may hold several records (some
+  // exporters write all vertices on one line), but a record does not continue on the next line.
+  tok.clear();
+  std::size_t next_token = 0;
   for (const PlyElement& e : elements) {
     const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
     for (long long r = 0; r < e.count; ++r) {
@@ -658,17 +693,23 @@ TriSurface read_ply(const std::string& path) {
       };
       scalars.assign(e.properties.size(), 0.0);
       list.clear();
-      std::size_t next_token = 0;
-      if (!binary) {
+      if (!binary && next_token == tok.size()) {
         do {
           if (!body.next(tok, false)) throw cut_off();
         } while (tok.empty());
+        next_token = 0;
       }
+      const std::size_t record_start = next_token;
       auto ascii_value = [&](const std::string& type) {
         double v = 0.0;
         if (next_token >= tok.size())
-          throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": " +
-                           record + " has too few values; fix the line or export again");
+          throw InputError(
+              quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": " + record +
+              (record_start == 0 ? std::string(" has too few values")
+                                 : " starts after value " + std::to_string(record_start) +
+                                       " of the line and the line ends inside it: its " +
+                                       std::to_string(tok.size()) + " values are not whole records") +
+              "; fix the line or export again");
         const bool integer_type =
             type != "float" && type != "float32" && type != "double" && type != "float64";
         if (!parse_double(tok[next_token], v) || (integer_type && std::isfinite(v) && std::floor(v) != v))
@@ -719,13 +760,15 @@ TriSurface read_ply(const std::string& path) {
                      "elements the header announces (from byte " + std::to_string(at) + " of " +
                      std::to_string(bytes.size()) + "): its counts are wrong or two files were joined; " +
                      "fix the counts or export the surface again");
-  if (!binary)
-    while (body.next(tok, false))
-      if (!tok.empty())
-        throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": '" +
-                         joined(tok) +
-                         "' after the elements the header announces: its counts are wrong or two files were "
-                         "joined; fix the counts or export the surface again");
+  if (!binary) {
+    std::vector<std::string_view> rest(tok.begin() + static_cast<std::ptrdiff_t>(next_token), tok.end());
+    while (rest.empty() && body.next(rest, false)) continue;
+    if (!rest.empty())
+      throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": '" +
+                       joined(rest) +
+                       "' after the elements the header announces: its counts are wrong or two files were "
+                       "joined; fix the counts or export the surface again");
+  }
   std::vector<int> corners;
   for (std::size_t f = 0, begin = 0; f < face_ends.size(); begin = face_ends[f++]) {
     corners.clear();

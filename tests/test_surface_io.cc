@@ -276,6 +276,69 @@ TEST(SurfaceIo, OffWithCommentsPolygonsAndColours) {
   EXPECT_NEAR(r.volume_mm3, 1.0, 1e-12);
 }
 
+// OFF is whitespace-delimited: several vertices on a line were read as one vertex and "colours", the face
+// lines then as vertices, ending in "it was cut off". Without a C in the header a vertex has no colour, so
+// the line's values are whole vertices; with one (COFF), one vertex per line.
+TEST(SurfaceIo, OffWithSeveralVerticesOnALine) {
+  const std::string dir = temp_dir();
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  write_file(dir + "/pairs.off", "OFF\n4 4 0\n0 0 0 10 0 0\n0 10 0 0 0 10\n" + faces);
+  TriSurface s = read_surface(dir + "/pairs.off");
+  ASSERT_EQ(s.vertices.size(), 4u);
+  EXPECT_EQ(s.vertices[3], (Vec3{0, 0, 10}));
+  EXPECT_TRUE(check_surface(s).usable());
+  write_file(dir + "/normals.off",
+             "NOFF\n4 4 0\n0 0 0 0 0 1 10 0 0 0 0 1\n0 10 0 0 0 1\n0 0 10 0 0 1\n" + faces);
+  EXPECT_EQ(read_surface(dir + "/normals.off").vertices.at(1), (Vec3{10, 0, 0}));
+  write_file(dir + "/colours.off",
+             "COFF\n4 4 0\n0 0 0 255 0 0 255\n10 0 0 255 0 0\n0 10 0 1 1 1 1\n0 0 10 0 0 0 1\n" + faces);
+  EXPECT_EQ(read_surface(dir + "/colours.off").vertices.at(3), (Vec3{0, 0, 10}));
+
+  // What is not whole vertices is named with its line.
+  write_file(dir + "/seven.off", "OFF\n4 4 0\n0 0 0 255 0 0 255\n10 0 0\n0 10 0\n0 0 10\n" + faces);
+  expect_input_error(
+      [&] { read_surface(dir + "/seven.off"); },
+      {"line 3: malformed OFF line '0 0 0 255 0 0 255'", "vertex 2 as 'x y z'",
+       "7 values are not whole vertices of 3 values each", "vertex colours need a COFF header"});
+  write_file(dir + "/two_coloured.off",
+             "COFF\n4 4 0\n0 0 0 1 1 1 1 10 0 0 1 1 1 1\n0 10 0 1 1 1 1\n0 0 10 1 1 1 1\n" + faces);
+  expect_input_error(
+      [&] { read_surface(dir + "/two_coloured.off"); },
+      {"line 3", "vertex 0 as 'x y z r g b [a]', one vertex per line (the line has 14 values)"});
+  write_file(dir + "/spill.off", "OFF\n3 1 0\n0 0 0 1 0 0\n0 1 0 3 0 1 2\n");
+  expect_input_error([&] { read_surface(dir + "/spill.off"); },
+                     {"line 4", "no more values after vertex 2, the last of the 3 the header announces"});
+  write_file(dir + "/two_faces.off", "OFF\n4 4 0\n0 0 0\n10 0 0\n0 10 0\n0 0 10\n3 0 2 1 3 0 1 3 3 0 3 2\n");
+  expect_input_error([&] { read_surface(dir + "/two_faces.off"); },
+                     {"line 7", "face 0 as 'k i_1 ... i_k [colour]' on a line of its own",
+                      "after its 3 indices come 8 values"});
+}
+
+// ASCII PLY records are read by the header's properties: several on a line were one record each, the rest
+// of the line dropped.
+TEST(SurfaceIo, AsciiPlyWithSeveralRecordsOnALine) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string faces = "3 0 2 1 3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const std::string dir = temp_dir();
+  write_file(dir + "/pairs.ply", header + "0 0 0 10 0 0\n0 10 0 0 0 10\n" + faces);
+  TriSurface s = read_surface(dir + "/pairs.ply");
+  ASSERT_EQ(s.vertices.size(), 4u);
+  EXPECT_EQ(s.vertices[3], (Vec3{0, 0, 10}));
+  EXPECT_TRUE(check_surface(s).usable());
+  // A record does not continue on the next line.
+  write_file(dir + "/split.ply", header + "0 0 0 10 0\n0 0 10 0 0 0 10\n" + faces);
+  expect_input_error(
+      [&] { read_surface(dir + "/split.ply"); },
+      {"line 10: vertex 1 (0-based) starts after value 3 of the line and the line ends inside it",
+       "its 5 values are not whole records"});
+  write_file(dir + "/more.ply",
+             header + "0 0 0 10 0 0\n0 10 0 0 0 10\n" + faces.substr(0, faces.size() - 1) + " 5\n");
+  expect_input_error([&] { read_surface(dir + "/more.ply"); },
+                     {"line 14: '5' after the elements the header announces"});
+}
+
 TEST(SurfaceIo, AsciiPlyWithExtraProperties) {
   const std::string text =
       "ply\nformat ascii 1.0\ncomment unit cube\nelement vertex 8\nproperty float x\nproperty float y\n"
