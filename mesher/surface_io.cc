@@ -117,34 +117,46 @@ class LineReader {
  public:
   explicit LineReader(std::string_view text) : text_(text) {}
 
-  // Next line split into whitespace-separated tokens; false at the end of the text.
-  bool next(std::vector<std::string_view>& tokens, bool strip_comments) {
+  // Next line split into whitespace-separated tokens; false at the end of the text. With `join_continued`
+  // (OBJ), a line ending in a backslash continues on the next one.
+  bool next(std::vector<std::string_view>& tokens, bool strip_comments, bool join_continued = false) {
     tokens.clear();
     if (pos_ >= text_.size()) return false;
-    std::size_t end = text_.find('\n', pos_);
-    if (end == std::string_view::npos) end = text_.size();
-    std::string_view line = text_.substr(pos_, end - pos_);
-    pos_ = end + 1;
-    ++line_;
-    if (strip_comments) line = line.substr(0, line.find('#'));
-    std::size_t i = 0;
-    while (i < line.size()) {
-      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-      std::size_t j = i;
-      while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
-      if (j > i) tokens.push_back(line.substr(i, j - i));
-      i = j;
+    first_line_ = line_ + 1;
+    bool continued = true;
+    while (continued && pos_ < text_.size()) {
+      std::size_t end = text_.find('\n', pos_);
+      if (end == std::string_view::npos) end = text_.size();
+      std::string_view line = text_.substr(pos_, end - pos_);
+      pos_ = end + 1;
+      ++line_;
+      if (strip_comments) line = line.substr(0, line.find('#'));
+      const std::size_t last = line.find_last_not_of(" \t\r\f\v");
+      continued = join_continued && last != std::string_view::npos && line[last] == '\\';
+      if (continued) line = line.substr(0, last);
+      std::size_t i = 0;
+      while (i < line.size()) {
+        while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+        std::size_t j = i;
+        while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+        if (j > i) tokens.push_back(line.substr(i, j - i));
+        i = j;
+      }
     }
     return true;
   }
 
-  std::size_t line() const { return line_; }
+  std::size_t line() const { return line_; }     // the last line read
   std::size_t position() const { return pos_; }  // byte offset of the next line
-  std::string where() const { return "line " + std::to_string(line_); }
+  // "line 7", or "lines 7-8" for a line continued on the next.
+  std::string where() const {
+    return first_line_ == line_ ? "line " + std::to_string(line_)
+                                : "lines " + std::to_string(first_line_) + "-" + std::to_string(line_);
+  }
 
  private:
   std::string_view text_;
-  std::size_t pos_ = 0, line_ = 0;
+  std::size_t pos_ = 0, line_ = 0, first_line_ = 0;
 };
 
 std::string joined(const std::vector<std::string_view>& tokens) {
@@ -361,8 +373,8 @@ TriSurface read_obj(const std::string& path) {
   // Positive indices may (in lenient exporters) refer to vertices defined further down: they are
   // checked against the final count, remembering the line of each face for the message.
   long long max_positive = 0;
-  std::size_t max_line = 0;
-  while (lines.next(tok, true)) {
+  std::string max_where;
+  while (lines.next(tok, true, true)) {
     if (tok.empty()) continue;
     const std::string_view key = tok[0];
     if (key == "v") {
@@ -392,7 +404,7 @@ TriSurface read_obj(const std::string& path) {
                            " vertices are defined above this line; fix the face or export again");
         if (index > 0 && index > max_positive) {
           max_positive = index;
-          max_line = lines.line();
+          max_where = lines.where();
         }
         if (zero_based > INT32_MAX)
           throw InputError(quoted(path) + " " + lines.where() + ": face index " + std::to_string(index) +
@@ -410,9 +422,9 @@ TriSurface read_obj(const std::string& path) {
     }
   }
   if (max_positive > static_cast<long long>(s.vertices.size()))
-    throw InputError(quoted(path) + " line " + std::to_string(max_line) + ": face index " +
-                     std::to_string(max_positive) + " is out of range: the file defines only " +
-                     std::to_string(s.vertices.size()) + " vertices (OBJ indices start at 1); fix the face");
+    throw InputError(quoted(path) + " " + max_where + ": face index " + std::to_string(max_positive) +
+                     " is out of range: the file defines only " + std::to_string(s.vertices.size()) +
+                     " vertices (OBJ indices start at 1); fix the face");
   return s;
 }
 

@@ -506,6 +506,24 @@ TEST(SurfaceIo, OffAndPlyByteOrderMarkIsSkipped) {
   EXPECT_EQ(read_surface(path).triangles.size(), 12u);
 }
 
+// A backslash at the end of an OBJ line continues the statement on the next line (Wavefront spec): it was
+// "malformed OBJ face line 'f 1 3 \\'". Messages name the lines of a continued statement.
+TEST(SurfaceIo, ObjLineContinuation) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/joined.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 \\\n 1\nf 1 3 \\\n2\nf 1 2 4\nf 1 4 3\\  \r\n\nf 2 3 4\n");
+  const TriSurface s = read_surface(dir + "/joined.obj");
+  ASSERT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.vertices.at(3), (Vec3{0, 0, 1}));
+  EXPECT_EQ(s.triangles[0], (std::array<int, 3>{0, 2, 1}));
+  EXPECT_EQ(s.triangles[3], (std::array<int, 3>{1, 2, 3}));
+  write_file(dir + "/bad.obj", "v 0 0 0\nv 1 0 \\\nzero\nv 0 1 0\nf 1 2 x\n");
+  expect_input_error([&] { read_surface(dir + "/bad.obj"); },
+                     {"bad.obj' lines 2-3: malformed OBJ vertex line 'v 1 0 zero'"});
+  write_file(dir + "/bad2.obj", "v 0 0 0\nv 1 0 \\\n0\nv 0 1 0\nf 1 2 x\n");
+  expect_input_error([&] { read_surface(dir + "/bad2.obj"); }, {"bad2.obj' line 5: malformed OBJ face line"});
+}
+
 // Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
 // infinities (1e40 does not fit a float), `mesh` stopped on a CGAL assertion (1e16).
 TEST(SurfaceIoErrors, CoordinatesBeyondAKilometreAreRefused) {
