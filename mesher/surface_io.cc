@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <iostream>
 #include <sstream>
 #include <string_view>
 
@@ -342,13 +343,25 @@ TriSurface read_stl(const std::string& path) {
                      " is a truncated binary STL: the header alone needs 84 bytes but the file has " +
                      std::to_string(bytes.size()) + " bytes; export it again");
   const std::uint64_t n = get_u32(bytes, 80), expected = 84 + 50 * n;
-  throw InputError(
-      "surface file " + quoted(path) + " is a truncated or corrupt binary STL: its header announces " +
-      std::to_string(n) + " triangles, which take 84 + 50 x " + std::to_string(n) + " = " +
-      std::to_string(expected) + " bytes, but the file has " + std::to_string(bytes.size()) + " bytes (" +
-      (bytes.size() < expected ? "missing " : "extra ") +
-      std::to_string(bytes.size() < expected ? expected - bytes.size() : bytes.size() - expected) +
-      "); export or download it again");
+  const std::string announced = "its header announces " + std::to_string(n) +
+                                " triangles, which take 84 + 50 x " + std::to_string(n) + " = " +
+                                std::to_string(expected) + " bytes, but the file has " +
+                                std::to_string(bytes.size()) + " bytes";
+  if (bytes.size() < expected)
+    throw InputError("surface file " + quoted(path) + " is a truncated or corrupt binary STL: " + announced +
+                     " (missing " + std::to_string(expected - bytes.size()) +
+                     "); export or download it again");
+  // Fewer bytes than a record after the announced ones: a line end or padding some tools append, not data.
+  const std::uint64_t extra = bytes.size() - expected;
+  if (extra < 50) {
+    std::cerr << "hexbite: warning: " << quoted(path) << ": " << announced << " (" << extra
+              << " more, less than a triangle record); the " << n
+              << " triangles are read and the extra bytes ignored\n";
+    return read_binary_stl(path, bytes);
+  }
+  throw InputError("surface file " + quoted(path) + " is a corrupt binary STL: " + announced + ", " +
+                   std::to_string(extra) +
+                   " more: the count is wrong or other data was appended; export or " + "download it again");
 }
 
 // ------------------------------------------------------------------------------------------------

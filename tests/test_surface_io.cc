@@ -524,6 +524,30 @@ TEST(SurfaceIo, ObjLineContinuation) {
   expect_input_error([&] { read_surface(dir + "/bad2.obj"); }, {"bad2.obj' line 5: malformed OBJ face line"});
 }
 
+// A binary STL with bytes after its announced records: fewer than a record (a line end) are ignored with a
+// warning (it was "truncated or corrupt ... (extra 1)"); a record or more is a wrong count.
+TEST(SurfaceIo, BinaryStlWithTrailingBytes) {
+  const std::string path = temp_dir() + "/trailing.stl";
+  write_surface(path, subdivided_cube(1));  // 12 triangles: 684 bytes
+  const std::string bytes = read_file(path);
+  write_file(path, bytes + "\n");
+  testing::internal::CaptureStderr();
+  const TriSurface s = read_surface(path);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(s.triangles.size(), 12u);
+  EXPECT_NE(
+      err.find("hexbite: warning: '" + path +
+               "': its header announces 12 triangles, which take 84 + 50 x 12 = 684 bytes, but the file "
+               "has 685 bytes (1 more, less than a triangle record); the 12 triangles are read and the "
+               "extra bytes ignored"),
+      std::string::npos)
+      << err;
+  write_file(path, bytes + bytes.substr(84, 50));
+  expect_input_error([&] { read_surface(path); },
+                     {"is a corrupt binary STL: its header announces 12 triangles",
+                      "the file has 734 bytes, 50 more", "the count is wrong or other data was appended"});
+}
+
 // Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
 // infinities (1e40 does not fit a float), `mesh` stopped on a CGAL assertion (1e16).
 TEST(SurfaceIoErrors, CoordinatesBeyondAKilometreAreRefused) {
