@@ -107,6 +107,13 @@ void require_triangles(const std::string& path, const TriSurface& s) {
                      "as a triangle mesh");
 }
 
+// For a header count beyond what a TriSurface indexes (int): "4000000000 vertices, more than ...".
+std::string too_many(long long count, const std::string& what) {
+  return std::to_string(count) + " " + what +
+         ", more than hexbite reads (at most 2147483647 = 2^31 - 1): the " +
+         "count is damaged, or the surface must be reduced first";
+}
+
 // Appends the polygon corners[0..n) fanned around its first corner: (0, i, i + 1).
 void add_fanned(TriSurface& s, const std::vector<int>& corners) {
   for (std::size_t i = 1; i + 1 < corners.size(); ++i)
@@ -481,8 +488,12 @@ TriSurface read_off(const std::string& path) {
   }
   long long nv = 0, nf = 0;
   if (tok.size() < first_count + 2 || !parse_integer(tok[first_count], nv) ||
-      !parse_integer(tok[first_count + 1], nf) || nv < 0 || nf < 0 || nv > INT32_MAX || nf > INT32_MAX)
+      !parse_integer(tok[first_count + 1], nf) || nv < 0 || nf < 0)
     throw malformed("the counts 'vertices faces edges' as non-negative integers");
+  if (nv > INT32_MAX || nf > INT32_MAX)
+    throw InputError(quoted(path) + " " + lines.where() + ": the header announces " +
+                     too_many(nv > INT32_MAX ? nv : nf, nv > INT32_MAX ? "vertices" : "faces") +
+                     "; fix the counts or export the surface again");
 
   TriSurface s;
   // The count is the file's word: a damaged header ("2000000000 1 0") must not reserve more than the file
@@ -635,9 +646,11 @@ TriSurface read_ply(const std::string& path) {
       have_format = true;
     } else if (tok[0] == "element") {
       PlyElement e;
-      if (tok.size() != 3 || !parse_integer(tok[2], e.count) || e.count < 0 || e.count > INT32_MAX)
-        throw header_error("expected 'element NAME COUNT'");
+      if (tok.size() != 3 || !parse_integer(tok[2], e.count) || e.count < 0)
+        throw header_error("expected 'element NAME COUNT' with a non-negative integer COUNT");
       e.name = std::string(tok[1]);
+      if (e.count > INT32_MAX)
+        throw header_error("'element " + e.name + "' announces " + too_many(e.count, "records"));
       // A second vertex or face element (the first one empty, say) was read with the first one's property
       // places and crashed.
       if ((e.name == "vertex" || e.name == "face") &&

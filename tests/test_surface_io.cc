@@ -548,6 +548,21 @@ TEST(SurfaceIo, BinaryStlWithTrailingBytes) {
                       "the file has 734 bytes, 50 more", "the count is wrong or other data was appended"});
 }
 
+// Counts beyond 2^31 - 1 were "expected the counts ... as non-negative integers".
+TEST(SurfaceIoErrors, CountsBeyondWhatIsReadAreNamed) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/big.off", "OFF\n4000000000 4 0\n0 0 0\n");
+  expect_input_error(
+      [&] { read_surface(dir + "/big.off"); },
+      {"big.off' line 2: the header announces 4000000000 vertices, more than hexbite reads (at "
+       "most 2147483647 = 2^31 - 1)"});
+  write_file(dir + "/big.ply",
+             "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n");
+  expect_input_error(
+      [&] { read_surface(dir + "/big.ply"); },
+      {"big.ply' line 3: 'element vertex' announces 4000000000 records, more than hexbite reads"});
+}
+
 // Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
 // infinities (1e40 does not fit a float), `mesh` stopped on a CGAL assertion (1e16).
 TEST(SurfaceIoErrors, CoordinatesBeyondAKilometreAreRefused) {
