@@ -56,7 +56,7 @@ nlohmann::json report_json(const SurfaceReport& r) {
   // Undefined values are null rather than a number that could be mistaken for a measurement.
   j["genus"] = r.genus >= 0 ? nlohmann::json(r.genus) : nlohmann::json();
   j["bbox"] = {{"min", vec_json(r.bbox_min)}, {"max", vec_json(r.bbox_max)}};
-  j["volume_mm3"] = r.closed && r.genus >= 0 ? nlohmann::json(r.volume_mm3) : nlohmann::json();
+  j["volume_mm3"] = r.volume_defined() ? nlohmann::json(r.volume_mm3) : nlohmann::json();
   j["min_angle_deg"] = r.min_angle_deg;
   j["min_angle_histogram"] = r.min_angle_histogram;
   j["min_angle_bin_deg"] = 5;
@@ -103,8 +103,10 @@ std::string report_text(const SurfaceReport& r) {
                           fixed(r.bbox_min[2], 2) + ") to (" + fixed(r.bbox_max[0], 2) + ", " +
                           fixed(r.bbox_max[1], 2) + ", " + fixed(r.bbox_max[2], 2) + ") mm");
   row("size", fixed(size[0], 2) + " x " + fixed(size[1], 2) + " x " + fixed(size[2], 2) + " mm");
-  if (r.closed && r.genus >= 0)
+  if (r.volume_defined())
     row("enclosed volume", fixed(r.volume_mm3, 1) + " mm^3 (" + fixed(r.volume_mm3 / 1000.0, 3) + " cm^3)");
+  else if (r.closed && r.genus >= 0)
+    row("enclosed volume", "undefined (the components are oriented inconsistently with each other)");
   else
     row("enclosed volume", "undefined (not a closed, consistently oriented manifold)");
   row("minimum angle", fixed(r.min_angle_deg, 2) + " deg");

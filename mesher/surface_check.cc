@@ -18,10 +18,12 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/property_map.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <numeric>
 #include <sstream>
 
@@ -56,6 +58,7 @@ std::string plural(std::size_t n, const std::string& one, const std::string& man
 // Builds "N things (explanation), e.g. loc; loc; ... and K more; advice".
 std::string problem(std::size_t count, const std::string& what, const std::vector<std::string>& locations,
                     const std::string& advice) {
+  if (locations.empty()) return what + ". " + advice;
   std::string s = what + ", e.g. ";
   for (std::size_t i = 0; i < locations.size(); ++i) s += (i ? "; " : "") + locations[i];
   if (count > locations.size()) s += "; and " + std::to_string(count - locations.size()) + " more";
@@ -287,6 +290,58 @@ bool is_outward(const Mesh& mesh, std::size_t components, bool self_intersecting
   return PMP::volume(mesh) > 0;
 }
 
+// Names the components of a closed surface without self-intersections that no single flip orients: each
+// component should face outward at an even nesting depth (an outer shell) and inward at an odd one (a
+// cavity). Reversing either the components against that rule or all the others (the global flip then
+// repairs the rest) fixes the surface, so the smaller group is named, each with where it is.
+template <class ComponentMap>
+std::string misoriented_components(const TriSurface& s, const Mesh& mesh, ComponentMap component,
+                                   std::size_t components) {
+  std::vector<std::size_t> nesting;
+  std::vector<bool> outward;
+  // Only the nesting and orientation of each component are needed, not the volume each face bounds.
+  CGAL::Constant_property_map<Mesh::Face_index, std::size_t> volume(0);
+  PMP::volume_connected_components(mesh, volume,
+                                   CGAL::parameters::face_connected_component_map(component)
+                                       .nesting_levels(std::ref(nesting))
+                                       .is_cc_outward_oriented(std::ref(outward)));
+  std::vector<std::size_t> against, along;
+  for (std::size_t c = 0; c < components; ++c)
+    (outward[c] == (nesting[c] % 2 == 0) ? along : against).push_back(c);
+  const std::vector<std::size_t>& named = against.size() <= along.size() ? against : along;
+
+  std::vector<std::size_t> triangles(components, 0), first(components, SIZE_MAX);
+  std::vector<Vec3> lo(components, Vec3{HUGE_VAL, HUGE_VAL, HUGE_VAL}),
+      hi(components, Vec3{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL});
+  for (Mesh::Face_index f : mesh.faces()) {
+    const std::size_t c = component[f], t = f.idx();  // face t of the mesh is triangle t of the soup
+    ++triangles[c];
+    first[c] = std::min(first[c], t);
+    for (int v : s.triangles[t])
+      for (int k = 0; k < 3; ++k) {
+        lo[c][k] = std::min(lo[c][k], s.vertices[v][k]);
+        hi[c][k] = std::max(hi[c][k], s.vertices[v][k]);
+      }
+  }
+  std::vector<std::string> where;
+  for (std::size_t i = 0; i < std::min(kShownLocations, named.size()); ++i) {
+    const std::size_t c = named[i];
+    where.push_back("component " + std::to_string(c) + " of " +
+                    plural(triangles[c], "triangle", "triangles") + " (the first is triangle " +
+                    std::to_string(first[c]) + ") from " + fmt(lo[c]) + " to " + fmt(hi[c]) + ", " +
+                    (nesting[c] % 2 == 0 ? "an outer shell" : "a cavity") + " facing " +
+                    (outward[c] ? "outward" : "inward"));
+  }
+  return problem(named.size(),
+                 "the closed components are oriented inconsistently with each other and no single flip makes "
+                 "the surface bound a volume: " +
+                     plural(named.size(), "component of ", "components of ") + std::to_string(components) +
+                     (named.size() == 1 ? " faces" : " face") + " against the others",
+                 where,
+                 "Reverse the triangles of the components named (every outer shell must face outward and "
+                 "every cavity inward).");
+}
+
 }  // namespace
 
 SurfaceReport check_surface(TriSurface& surface, const std::string& file_name) {
@@ -494,11 +549,8 @@ SurfaceReport check_surface(TriSurface& surface, const std::string& file_name) {
                           " triangles: the surface was consistently oriented inward, it now faces outward");
     } else {
       PMP::reverse_face_orientations(mesh);
-      r.problems.push_back(
-          "the closed components are oriented inconsistently with each other (some outward, some inward) and "
-          "no single flip makes the surface bound a volume. Orient every outer shell outward and every "
-          "cavity "
-          "inward.");
+      r.problems.push_back(misoriented_components(s, mesh, face_component, r.components));
+      return r;  // the volume is undefined: the components do not bound one
     }
   }
   r.volume_mm3 = PMP::volume(mesh);

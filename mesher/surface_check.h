@@ -19,12 +19,14 @@ struct SurfaceReport {
   long euler_characteristic = 0;
   long genus = -1;  // -1 when undefined (open or non-manifold)
   Vec3 bbox_min{}, bbox_max{};
-  double volume_mm3 = 0.0;                       // enclosed volume, when closed
+  double volume_mm3 = 0.0;                       // enclosed volume, when volume_defined()
   double min_angle_deg = 0.0;                    // smallest triangle angle
   std::vector<std::size_t> min_angle_histogram;  // triangles per 5-degree bin of their minimum angle, 0..60
   std::vector<std::string> repairs;              // what was repaired, one sentence each
   std::vector<std::string> problems;  // what is wrong and where (index, coordinates), one sentence each
   bool usable() const { return problems.empty(); }
+  // Closed, manifold and oriented (after a repair flip) so that it encloses a volume.
+  bool volume_defined() const { return outward; }
 };
 
 // Applies the safe repairs (merge duplicate vertices, drop unreferenced ones, drop repeated triangles of the

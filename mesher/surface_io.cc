@@ -21,12 +21,15 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <iostream>
 #include <sstream>
 #include <string_view>
 
@@ -104,6 +107,13 @@ void require_triangles(const std::string& path, const TriSurface& s) {
                      "as a triangle mesh");
 }
 
+// For a header count beyond what a TriSurface indexes (int): "4000000000 vertices, more than ...".
+std::string too_many(long long count, const std::string& what) {
+  return std::to_string(count) + " " + what +
+         ", more than hexbite reads (at most 2147483647 = 2^31 - 1): the " +
+         "count is damaged, or the surface must be reduced first";
+}
+
 // Appends the polygon corners[0..n) fanned around its first corner: (0, i, i + 1).
 void add_fanned(TriSurface& s, const std::vector<int>& corners) {
   for (std::size_t i = 1; i + 1 < corners.size(); ++i)
@@ -115,34 +125,46 @@ class LineReader {
  public:
   explicit LineReader(std::string_view text) : text_(text) {}
 
-  // Next line split into whitespace-separated tokens; false at the end of the text.
-  bool next(std::vector<std::string_view>& tokens, bool strip_comments) {
+  // Next line split into whitespace-separated tokens; false at the end of the text. With `join_continued`
+  // (OBJ), a line ending in a backslash continues on the next one.
+  bool next(std::vector<std::string_view>& tokens, bool strip_comments, bool join_continued = false) {
     tokens.clear();
     if (pos_ >= text_.size()) return false;
-    std::size_t end = text_.find('\n', pos_);
-    if (end == std::string_view::npos) end = text_.size();
-    std::string_view line = text_.substr(pos_, end - pos_);
-    pos_ = end + 1;
-    ++line_;
-    if (strip_comments) line = line.substr(0, line.find('#'));
-    std::size_t i = 0;
-    while (i < line.size()) {
-      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-      std::size_t j = i;
-      while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
-      if (j > i) tokens.push_back(line.substr(i, j - i));
-      i = j;
+    first_line_ = line_ + 1;
+    bool continued = true;
+    while (continued && pos_ < text_.size()) {
+      std::size_t end = text_.find('\n', pos_);
+      if (end == std::string_view::npos) end = text_.size();
+      std::string_view line = text_.substr(pos_, end - pos_);
+      pos_ = end + 1;
+      ++line_;
+      if (strip_comments) line = line.substr(0, line.find('#'));
+      const std::size_t last = line.find_last_not_of(" \t\r\f\v");
+      continued = join_continued && last != std::string_view::npos && line[last] == '\\';
+      if (continued) line = line.substr(0, last);
+      std::size_t i = 0;
+      while (i < line.size()) {
+        while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+        std::size_t j = i;
+        while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+        if (j > i) tokens.push_back(line.substr(i, j - i));
+        i = j;
+      }
     }
     return true;
   }
 
-  std::size_t line() const { return line_; }
+  std::size_t line() const { return line_; }     // the last line read
   std::size_t position() const { return pos_; }  // byte offset of the next line
-  std::string where() const { return "line " + std::to_string(line_); }
+  // "line 7", or "lines 7-8" for a line continued on the next.
+  std::string where() const {
+    return first_line_ == line_ ? "line " + std::to_string(line_)
+                                : "lines " + std::to_string(first_line_) + "-" + std::to_string(line_);
+  }
 
  private:
   std::string_view text_;
-  std::size_t pos_ = 0, line_ = 0;
+  std::size_t pos_ = 0, line_ = 0, first_line_ = 0;
 };
 
 std::string joined(const std::vector<std::string_view>& tokens) {
@@ -197,8 +219,15 @@ std::string first_word(const std::string& bytes) {
   return bytes.substr(i, end - i);
 }
 
+// Keywords of text formats are compared in lower case: exporters write "SOLID", "Facet", "VERTEX" too.
+std::string lower_case(std::string_view word) {
+  std::string s(word);
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
 bool looks_like_ascii_stl(const std::string& bytes) {
-  return first_word(bytes).rfind("solid", 0) == 0 && is_text(bytes);
+  return lower_case(first_word(bytes)).rfind("solid", 0) == 0 && is_text(bytes);
 }
 
 TriSurface read_binary_stl(const std::string& path, const std::string& bytes) {
@@ -222,6 +251,8 @@ TriSurface read_binary_stl(const std::string& path, const std::string& bytes) {
   return s;
 }
 
+// Read by statements rather than by lines: a line may hold several of them (some exporters write the whole
+// file on one line), and each statement's words are on the line of its keyword.
 TriSurface read_ascii_stl(const std::string& path, const std::string& bytes) {
   TriSurface s;
   LineReader lines(bytes);
@@ -234,38 +265,55 @@ TriSurface read_ascii_stl(const std::string& path, const std::string& bytes) {
                       "': expected " + expected + "; fix the line or export the surface again");
   };
   while (lines.next(tok, false)) {
-    if (tok.empty()) continue;
-    const std::string_view key = tok[0];
-    if (key == "solid" || key == "endsolid") {
-      if (in_facet) throw malformed("'endfacet' before '" + std::string(key) + "'");
-    } else if (key == "facet") {
-      if (in_facet) throw malformed("'endfacet' before the next facet");
-      in_facet = true;
-      facet_line = lines.line();
-    } else if (key == "outer") {
-      if (!in_facet || in_loop || tok.size() != 2 || tok[1] != "loop")
-        throw malformed("'outer loop' directly after 'facet normal nx ny nz'");
-      in_loop = true;
-      loop.clear();
-    } else if (key == "vertex") {
-      if (!in_loop) throw malformed("'vertex' only between 'outer loop' and 'endloop'");
-      Vec3 p;
-      if (tok.size() != 4 || !parse_point(tok, 1, p)) throw malformed("'vertex x y z' with three numbers");
-      require_finite(path, lines.where(), p);
-      loop.push_back(static_cast<int>(s.vertices.size()));
-      s.vertices.push_back(p);
-    } else if (key == "endloop") {
-      if (!in_loop) throw malformed("'endloop' only after 'outer loop'");
-      if (loop.size() < 3)
-        throw malformed("at least three 'vertex' lines in the facet starting at line " +
-                        std::to_string(facet_line));
-      add_fanned(s, loop);
-      in_loop = false;
-    } else if (key == "endfacet") {
-      if (!in_facet || in_loop) throw malformed("'endloop' before 'endfacet'");
-      in_facet = false;
-    } else {
-      throw malformed("an STL keyword (solid, facet, outer loop, vertex, endloop, endfacet, endsolid)");
+    std::size_t i = 0;  // the next word of the line
+    // Skips the words up to the next one of `stops` on this line: a solid's name, a facet's normal.
+    auto skip_to = [&](std::initializer_list<const char*> stops) {
+      while (i < tok.size() &&
+             std::none_of(stops.begin(), stops.end(), [&](const char* k) { return lower_case(tok[i]) == k; }))
+        ++i;
+    };
+    while (i < tok.size()) {
+      const std::string key = lower_case(tok[i++]);
+      if (key == "solid" || key == "endsolid") {
+        if (in_facet) throw malformed("'endfacet' before '" + std::string(tok[i - 1]) + "'");
+        if (key == "solid")
+          skip_to({"facet", "endsolid"});
+        else
+          skip_to({"solid"});
+      } else if (key == "facet") {
+        if (in_facet) throw malformed("'endfacet' before the next facet");
+        in_facet = true;
+        facet_line = lines.line();
+        skip_to({"outer"});  // the normal is recomputed from the corners
+      } else if (key == "outer") {
+        if (!in_facet || in_loop || i == tok.size() || lower_case(tok[i]) != "loop")
+          throw malformed("'outer loop' directly after 'facet normal nx ny nz'");
+        ++i;
+        in_loop = true;
+        loop.clear();
+      } else if (key == "vertex") {
+        if (!in_loop) throw malformed("'vertex' only between 'outer loop' and 'endloop'");
+        Vec3 p;
+        double extra = 0.0;
+        if (!parse_point(tok, i, p) || (i + 3 < tok.size() && parse_double(tok[i + 3], extra)))
+          throw malformed("'vertex x y z' with three numbers");
+        i += 3;
+        require_finite(path, lines.where(), p);
+        loop.push_back(static_cast<int>(s.vertices.size()));
+        s.vertices.push_back(p);
+      } else if (key == "endloop") {
+        if (!in_loop) throw malformed("'endloop' only after 'outer loop'");
+        if (loop.size() < 3)
+          throw malformed("at least three 'vertex' lines in the facet starting at line " +
+                          std::to_string(facet_line));
+        add_fanned(s, loop);
+        in_loop = false;
+      } else if (key == "endfacet") {
+        if (!in_facet || in_loop) throw malformed("'endloop' before 'endfacet'");
+        in_facet = false;
+      } else {
+        throw malformed("an STL keyword (solid, facet, outer loop, vertex, endloop, endfacet, endsolid)");
+      }
     }
   }
   if (in_facet)
@@ -302,13 +350,25 @@ TriSurface read_stl(const std::string& path) {
                      " is a truncated binary STL: the header alone needs 84 bytes but the file has " +
                      std::to_string(bytes.size()) + " bytes; export it again");
   const std::uint64_t n = get_u32(bytes, 80), expected = 84 + 50 * n;
-  throw InputError(
-      "surface file " + quoted(path) + " is a truncated or corrupt binary STL: its header announces " +
-      std::to_string(n) + " triangles, which take 84 + 50 x " + std::to_string(n) + " = " +
-      std::to_string(expected) + " bytes, but the file has " + std::to_string(bytes.size()) + " bytes (" +
-      (bytes.size() < expected ? "missing " : "extra ") +
-      std::to_string(bytes.size() < expected ? expected - bytes.size() : bytes.size() - expected) +
-      "); export or download it again");
+  const std::string announced = "its header announces " + std::to_string(n) +
+                                " triangles, which take 84 + 50 x " + std::to_string(n) + " = " +
+                                std::to_string(expected) + " bytes, but the file has " +
+                                std::to_string(bytes.size()) + " bytes";
+  if (bytes.size() < expected)
+    throw InputError("surface file " + quoted(path) + " is a truncated or corrupt binary STL: " + announced +
+                     " (missing " + std::to_string(expected - bytes.size()) +
+                     "); export or download it again");
+  // Fewer bytes than a record after the announced ones: a line end or padding some tools append, not data.
+  const std::uint64_t extra = bytes.size() - expected;
+  if (extra < 50) {
+    std::cerr << "hexbite: warning: " << quoted(path) << ": " << announced << " (" << extra
+              << " more, less than a triangle record); the " << n
+              << " triangles are read and the extra bytes ignored\n";
+    return read_binary_stl(path, bytes);
+  }
+  throw InputError("surface file " + quoted(path) + " is a corrupt binary STL: " + announced + ", " +
+                   std::to_string(extra) +
+                   " more: the count is wrong or other data was appended; export or " + "download it again");
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -333,8 +393,8 @@ TriSurface read_obj(const std::string& path) {
   // Positive indices may (in lenient exporters) refer to vertices defined further down: they are
   // checked against the final count, remembering the line of each face for the message.
   long long max_positive = 0;
-  std::size_t max_line = 0;
-  while (lines.next(tok, true)) {
+  std::string max_where;
+  while (lines.next(tok, true, true)) {
     if (tok.empty()) continue;
     const std::string_view key = tok[0];
     if (key == "v") {
@@ -364,7 +424,7 @@ TriSurface read_obj(const std::string& path) {
                            " vertices are defined above this line; fix the face or export again");
         if (index > 0 && index > max_positive) {
           max_positive = index;
-          max_line = lines.line();
+          max_where = lines.where();
         }
         if (zero_based > INT32_MAX)
           throw InputError(quoted(path) + " " + lines.where() + ": face index " + std::to_string(index) +
@@ -382,19 +442,21 @@ TriSurface read_obj(const std::string& path) {
     }
   }
   if (max_positive > static_cast<long long>(s.vertices.size()))
-    throw InputError(quoted(path) + " line " + std::to_string(max_line) + ": face index " +
-                     std::to_string(max_positive) + " is out of range: the file defines only " +
-                     std::to_string(s.vertices.size()) + " vertices (OBJ indices start at 1); fix the face");
+    throw InputError(quoted(path) + " " + max_where + ": face index " + std::to_string(max_positive) +
+                     " is out of range: the file defines only " + std::to_string(s.vertices.size()) +
+                     " vertices (OBJ indices start at 1); fix the face");
   return s;
 }
 
 // ------------------------------------------------------------------------------------------------
-// OFF: header keyword (OFF, COFF, NOFF, CNOFF, STOFF, ...), counts "nv nf ne", nv vertex lines
-// "x y z [extras]", nf face lines "k i_1 .. i_k [colour]" with 0-based indices; '#' starts a comment.
+// OFF: header keyword (OFF, COFF, NOFF, CNOFF, STOFF, ...), counts "nv nf ne", nv vertices
+// "x y z [nx ny nz] [r g b [a]] [s t]" (the header's N, C and ST say which follow the coordinates), nf face
+// lines "k i_1 .. i_k [colour]" with 0-based indices; '#' starts a comment. OFF is whitespace-delimited, so
+// without colours (whose count varies) a line may hold several vertices; each lies on one line.
 
 TriSurface read_off(const std::string& path) {
   const std::string bytes = read_bytes(path);
-  LineReader lines(bytes);
+  LineReader lines(without_utf8_bom(bytes));
   std::vector<std::string_view> tok;
   auto next_nonblank = [&](const std::string& expecting) {
     while (lines.next(tok, true))
@@ -412,6 +474,13 @@ TriSurface read_off(const std::string& path) {
   const bool keyword_ok = keyword.size() >= 3 && keyword.substr(keyword.size() - 3) == "OFF" &&
                           keyword.find_first_not_of("STCN") == keyword.size() - 3;
   if (!keyword_ok) throw malformed("the keyword OFF (or COFF, NOFF, CNOFF, STOFF) on the first line");
+  const std::string_view prefix = keyword.substr(0, keyword.size() - 3);
+  const bool normals = prefix.find('N') != std::string_view::npos,
+             colours = prefix.find('C') != std::string_view::npos,
+             texture = prefix.find("ST") != std::string_view::npos;
+  const std::size_t per_vertex = 3 + (normals ? 3 : 0) + (texture ? 2 : 0);
+  const std::string vertex_form = std::string("'x y z") + (normals ? " nx ny nz" : "") +
+                                  (colours ? " r g b [a]" : "") + (texture ? " s t" : "") + "'";
   std::size_t first_count = 1;
   if (tok.size() == 1) {
     next_nonblank("the counts 'vertices faces edges'");
@@ -419,26 +488,52 @@ TriSurface read_off(const std::string& path) {
   }
   long long nv = 0, nf = 0;
   if (tok.size() < first_count + 2 || !parse_integer(tok[first_count], nv) ||
-      !parse_integer(tok[first_count + 1], nf) || nv < 0 || nf < 0 || nv > INT32_MAX || nf > INT32_MAX)
+      !parse_integer(tok[first_count + 1], nf) || nv < 0 || nf < 0)
     throw malformed("the counts 'vertices faces edges' as non-negative integers");
+  if (nv > INT32_MAX || nf > INT32_MAX)
+    throw InputError(quoted(path) + " " + lines.where() + ": the header announces " +
+                     too_many(nv > INT32_MAX ? nv : nf, nv > INT32_MAX ? "vertices" : "faces") +
+                     "; fix the counts or export the surface again");
 
   TriSurface s;
   // The count is the file's word: a damaged header ("2000000000 1 0") must not reserve more than the file
   // can hold (a vertex line takes at least 6 bytes), or it ends in std::bad_alloc instead of "cut off".
   s.vertices.reserve(std::min(static_cast<std::size_t>(nv), bytes.size() / 6));
+  std::size_t next = tok.size();  // the next value of the current line
   for (long long i = 0; i < nv; ++i) {
-    next_nonblank("vertex " + std::to_string(i) + " of " + std::to_string(nv));
+    if (next == tok.size()) {
+      next_nonblank("vertex " + std::to_string(i) + " of " + std::to_string(nv));
+      next = 0;
+    }
+    auto vertex = [&] { return "vertex " + std::to_string(i) + " as " + vertex_form; };
+    if (colours && (tok.size() < per_vertex || tok.size() > per_vertex + 4))
+      throw malformed(vertex() + ", one vertex per line (the line has " + std::to_string(tok.size()) +
+                      " values)");
+    if (!colours && tok.size() - next < per_vertex)
+      throw malformed(vertex() + ": the line's " + std::to_string(tok.size()) +
+                      " values are not whole vertices of " + std::to_string(per_vertex) +
+                      " values each (vertex colours need a COFF header)");
     Vec3 p;
-    if (!parse_point(tok, 0, p)) throw malformed("vertex " + std::to_string(i) + " as 'x y z'");
+    if (!parse_point(tok, next, p)) throw malformed(vertex());
     require_finite(path, lines.where() + " (vertex " + std::to_string(i) + ", 0-based)", p);
     s.vertices.push_back(p);
+    next = colours ? tok.size() : next + per_vertex;
   }
+  if (next < tok.size())
+    throw malformed("no more values after vertex " + std::to_string(nv - 1) + ", the last of the " +
+                    std::to_string(nv) + " the header announces (the faces follow, one per line)");
   std::vector<int> corners;
   for (long long f = 0; f < nf; ++f) {
     next_nonblank("face " + std::to_string(f) + " of " + std::to_string(nf));
     long long k = 0;
     if (!parse_integer(tok[0], k) || k < 3 || tok.size() < std::size_t(k) + 1)
       throw malformed("face " + std::to_string(f) + " as 'k i_1 ... i_k' with k >= 3 vertex indices");
+    // A colour is at most 4 values; more is a second face on the line, or a wrong k.
+    if (tok.size() > std::size_t(k) + 5)
+      throw malformed("face " + std::to_string(f) +
+                      " as 'k i_1 ... i_k [colour]' on a line of its own: after its " + std::to_string(k) +
+                      " indices come " + std::to_string(tok.size() - std::size_t(k) - 1) +
+                      " values, more than a colour's 4");
     corners.clear();
     for (long long i = 1; i <= k; ++i) {
       long long index = 0;
@@ -521,7 +616,9 @@ double ply_binary_value(const std::string& bytes, std::size_t at, const std::str
 
 TriSurface read_ply(const std::string& path) {
   const std::string bytes = read_bytes(path);
-  LineReader lines(bytes);
+  // The header is read after a UTF-8 byte order mark; binary offsets stay those of the file.
+  const std::size_t bom = bytes.size() - without_utf8_bom(bytes).size();
+  LineReader lines(std::string_view(bytes).substr(bom));
   std::vector<std::string_view> tok;
   auto header_error = [&](const std::string& what) {
     return InputError(quoted(path) + " " + lines.where() + ": " + what +
@@ -549,9 +646,11 @@ TriSurface read_ply(const std::string& path) {
       have_format = true;
     } else if (tok[0] == "element") {
       PlyElement e;
-      if (tok.size() != 3 || !parse_integer(tok[2], e.count) || e.count < 0 || e.count > INT32_MAX)
-        throw header_error("expected 'element NAME COUNT'");
+      if (tok.size() != 3 || !parse_integer(tok[2], e.count) || e.count < 0)
+        throw header_error("expected 'element NAME COUNT' with a non-negative integer COUNT");
       e.name = std::string(tok[1]);
+      if (e.count > INT32_MAX)
+        throw header_error("'element " + e.name + "' announces " + too_many(e.count, "records"));
       // A second vertex or face element (the first one empty, say) was read with the first one's property
       // places and crashed.
       if ((e.name == "vertex" || e.name == "face") &&
@@ -608,7 +707,7 @@ TriSurface read_ply(const std::string& path) {
   // The records follow the header line by line (ASCII) or byte by byte (binary). The faces' vertex lists are
   // checked after every element is read: the vertex element usually comes first, but the format allows
   // either order (a face element first was said to refer to vertices "out of range: the file has 0").
-  std::size_t at = std::min(lines.position(), bytes.size());
+  std::size_t at = std::min(bom + lines.position(), bytes.size());
   const bool binary = format != PlyFormat::kAscii;
   const bool big = format == PlyFormat::kBig;
   LineReader body(std::string_view(bytes).substr(at));
@@ -617,6 +716,10 @@ TriSurface read_ply(const std::string& path) {
   std::vector<long long> list;
   std::vector<long long> face_indices;  // every face's list, one after another
   std::vector<std::size_t> face_ends;   // where each face's list ends in face_indices
+  // ASCII records are read by values, as the header declares them: a line may hold several records (some
+  // exporters write all vertices on one line), but a record does not continue on the next line.
+  tok.clear();
+  std::size_t next_token = 0;
   for (const PlyElement& e : elements) {
     const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
     for (long long r = 0; r < e.count; ++r) {
@@ -628,17 +731,23 @@ TriSurface read_ply(const std::string& path) {
       };
       scalars.assign(e.properties.size(), 0.0);
       list.clear();
-      std::size_t next_token = 0;
-      if (!binary) {
+      if (!binary && next_token == tok.size()) {
         do {
           if (!body.next(tok, false)) throw cut_off();
         } while (tok.empty());
+        next_token = 0;
       }
+      const std::size_t record_start = next_token;
       auto ascii_value = [&](const std::string& type) {
         double v = 0.0;
         if (next_token >= tok.size())
-          throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": " +
-                           record + " has too few values; fix the line or export again");
+          throw InputError(
+              quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": " + record +
+              (record_start == 0 ? std::string(" has too few values")
+                                 : " starts after value " + std::to_string(record_start) +
+                                       " of the line and the line ends inside it: its " +
+                                       std::to_string(tok.size()) + " values are not whole records") +
+              "; fix the line or export again");
         const bool integer_type =
             type != "float" && type != "float32" && type != "double" && type != "float64";
         if (!parse_double(tok[next_token], v) || (integer_type && std::isfinite(v) && std::floor(v) != v))
@@ -689,13 +798,15 @@ TriSurface read_ply(const std::string& path) {
                      "elements the header announces (from byte " + std::to_string(at) + " of " +
                      std::to_string(bytes.size()) + "): its counts are wrong or two files were joined; " +
                      "fix the counts or export the surface again");
-  if (!binary)
-    while (body.next(tok, false))
-      if (!tok.empty())
-        throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": '" +
-                         joined(tok) +
-                         "' after the elements the header announces: its counts are wrong or two files were "
-                         "joined; fix the counts or export the surface again");
+  if (!binary) {
+    std::vector<std::string_view> rest(tok.begin() + static_cast<std::ptrdiff_t>(next_token), tok.end());
+    while (rest.empty() && body.next(rest, false)) continue;
+    if (!rest.empty())
+      throw InputError(quoted(path) + " line " + std::to_string(header_lines + body.line()) + ": '" +
+                       joined(rest) +
+                       "' after the elements the header announces: its counts are wrong or two files were "
+                       "joined; fix the counts or export the surface again");
+  }
   std::vector<int> corners;
   for (std::size_t f = 0, begin = 0; f < face_ends.size(); begin = face_ends[f++]) {
     corners.clear();

@@ -233,6 +233,33 @@ TEST(Cli, RepairedSurfaceIsWrittenInMillimetres) {
   EXPECT_NEAR(j["volume_mm3"].get<double>(), 1000.0, 1e-9);
 }
 
+TEST(Cli, SurfaceWhoseComponentsFaceDifferentWaysHasNoVolume) {
+  // The unit cube and, beside it, a copy facing inward: refused, with the copy named and no volume.
+  std::string text = cube_obj();
+  for (int v = 0; v < 8; ++v)
+    text += "v " + std::to_string(3 + (v & 1)) + " " + std::to_string((v >> 1) & 1) + " " +
+            std::to_string((v >> 2) & 1) + "\n";
+  for (const char* f : kCubeFaces) {
+    int a, b, c;
+    ASSERT_EQ(std::sscanf(f, "f %d %d %d", &a, &b, &c), 3);
+    text += "f " + std::to_string(a + 8) + " " + std::to_string(c + 8) + " " + std::to_string(b + 8) + "\n";
+  }
+  const std::string path = write_case("one_inward.obj", text);
+  auto r = run_hexbite({"surface", "check", path, "--json"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["volume_mm3"].is_null()) << j["volume_mm3"];
+  EXPECT_NE(
+      r.err.find("component 1 of 12 triangles (the first is triangle 12) from (3, 0, 0) to (4, 1, 1), an "
+                 "outer shell facing inward"),
+      std::string::npos)
+      << r.err;
+  r = run_hexbite({"surface", "check", path});
+  EXPECT_NE(r.out.find("enclosed volume       undefined (the components are oriented inconsistently"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(CliBadInput, MissingFile) {
   expect_rejected(temp_dir() + "/nowhere.stl", "does not exist");
 }

@@ -238,11 +238,46 @@ TEST(SurfaceCheck, GenusAndComponents) {
   EXPECT_TRUE(any_contains(r.repairs, "reversed the orientation"));
   EXPECT_NEAR(r.volume_mm3, 26.0, 1e-12);
 
-  // Outer shell and cavity both facing outward: no single flip helps.
+  // Outer shell and cavity both facing outward: no single flip helps, the cavity is named and there is
+  // no volume (the sum of both, 28, was reported).
   TriSurface wrong = merged(unit_cube({0, 0, 0}, 3.0), unit_cube({1, 1, 1}, 1.0));
   r = check_surface(wrong);
   EXPECT_FALSE(r.usable());
-  EXPECT_TRUE(any_contains(r.problems, "oriented inconsistently with each other")) << joined(r.problems);
+  EXPECT_FALSE(r.volume_defined());
+  EXPECT_TRUE(
+      any_contains(r.problems,
+                   "the closed components are oriented inconsistently with each other and no single "
+                   "flip makes the surface bound a volume: 1 component of 2 faces against the others, "
+                   "e.g. component 1 of 12 triangles (the first is triangle 12) from (1, 1, 1) to (2, 2, "
+                   "2), a cavity facing outward. Reverse the triangles of the components named"))
+      << joined(r.problems);
+}
+
+TEST(SurfaceCheck, ShellFacingInwardBesideOneFacingOutwardIsNamed) {
+  // Two separate cubes, the second inside out: the second is named; the volume is undefined (0 was reported).
+  TriSurface inward = unit_cube({3, 0, 0}, 2.0);
+  flip(inward);
+  TriSurface two = merged(unit_cube(), inward);
+  SurfaceReport r = check_surface(two);
+  EXPECT_FALSE(r.usable());
+  EXPECT_FALSE(r.volume_defined());
+  EXPECT_TRUE(any_contains(r.problems,
+                           "1 component of 2 faces against the others, e.g. component 1 of 12 "
+                           "triangles (the first is triangle 12) from (3, 0, 0) to (5, 2, 2), an "
+                           "outer shell facing inward."))
+      << joined(r.problems);
+
+  // Three inward beside one outward: reversing the outward one (the global flip does the rest) is the
+  // smaller repair, so that one is named.
+  TriSurface four = merged(merged(merged(unit_cube(), inward), inward), inward);
+  for (std::size_t v = 16; v < four.vertices.size(); ++v) four.vertices[v][1] += v < 24 ? 3.0 : 6.0;
+  r = check_surface(four);
+  EXPECT_EQ(r.components, 4u);
+  EXPECT_TRUE(any_contains(r.problems,
+                           "1 component of 4 faces against the others, e.g. component 0 of 12 "
+                           "triangles (the first is triangle 0) from (0, 0, 0) to (1, 1, 1), an "
+                           "outer shell facing outward."))
+      << joined(r.problems);
 }
 
 }  // namespace

@@ -214,6 +214,32 @@ TEST(SurfaceIo, AsciiStl) {
   expect_same_geometry(cube, read_surface(named), named);
 }
 
+// Keywords in upper case were "text that does not begin with 'solid'"; a file with all of it on one line
+// "contains no triangles" (everything was the solid's name).
+TEST(SurfaceIo, AsciiStlKeywordsInAnyCaseAndStatementsOnOneLine) {
+  const std::string facet =
+      "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+  std::string upper = "SOLID PART\n" + facet + "ENDSOLID PART\n";
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
+  const std::string dir = temp_dir();
+  write_file(dir + "/upper.stl", upper);
+  TriSurface s = read_surface(dir + "/upper.stl");
+  ASSERT_EQ(s.triangles.size(), 1u);
+  EXPECT_EQ(s.vertices[1], (Vec3{1, 0, 0}));
+
+  std::string one_line = "solid my part " + facet + facet + "endsolid my part";
+  std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+  write_file(dir + "/one_line.stl", one_line + "\n");
+  s = read_surface(dir + "/one_line.stl");
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.vertices[5], (Vec3{0, 1, 0}));
+  // A number too many is still named, on one line as on several.
+  one_line.replace(one_line.find("vertex 1 0 0"), 12, "vertex 1 0 0 7");
+  write_file(dir + "/four.stl", one_line + "\n");
+  expect_input_error([&] { read_surface(dir + "/four.stl"); },
+                     {"line 1", "expected 'vertex x y z' with three numbers"});
+}
+
 // Unit cube corners: vertex i has x = bit 0, y = bit 1, z = bit 2; faces as outward quads.
 const char* const kCubeVertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n";
 
@@ -248,6 +274,69 @@ TEST(SurfaceIo, OffWithCommentsPolygonsAndColours) {
   const SurfaceReport r = check_surface(s);
   EXPECT_TRUE(r.usable());
   EXPECT_NEAR(r.volume_mm3, 1.0, 1e-12);
+}
+
+// OFF is whitespace-delimited: several vertices on a line were read as one vertex and "colours", the face
+// lines then as vertices, ending in "it was cut off". Without a C in the header a vertex has no colour, so
+// the line's values are whole vertices; with one (COFF), one vertex per line.
+TEST(SurfaceIo, OffWithSeveralVerticesOnALine) {
+  const std::string dir = temp_dir();
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  write_file(dir + "/pairs.off", "OFF\n4 4 0\n0 0 0 10 0 0\n0 10 0 0 0 10\n" + faces);
+  TriSurface s = read_surface(dir + "/pairs.off");
+  ASSERT_EQ(s.vertices.size(), 4u);
+  EXPECT_EQ(s.vertices[3], (Vec3{0, 0, 10}));
+  EXPECT_TRUE(check_surface(s).usable());
+  write_file(dir + "/normals.off",
+             "NOFF\n4 4 0\n0 0 0 0 0 1 10 0 0 0 0 1\n0 10 0 0 0 1\n0 0 10 0 0 1\n" + faces);
+  EXPECT_EQ(read_surface(dir + "/normals.off").vertices.at(1), (Vec3{10, 0, 0}));
+  write_file(dir + "/colours.off",
+             "COFF\n4 4 0\n0 0 0 255 0 0 255\n10 0 0 255 0 0\n0 10 0 1 1 1 1\n0 0 10 0 0 0 1\n" + faces);
+  EXPECT_EQ(read_surface(dir + "/colours.off").vertices.at(3), (Vec3{0, 0, 10}));
+
+  // What is not whole vertices is named with its line.
+  write_file(dir + "/seven.off", "OFF\n4 4 0\n0 0 0 255 0 0 255\n10 0 0\n0 10 0\n0 0 10\n" + faces);
+  expect_input_error(
+      [&] { read_surface(dir + "/seven.off"); },
+      {"line 3: malformed OFF line '0 0 0 255 0 0 255'", "vertex 2 as 'x y z'",
+       "7 values are not whole vertices of 3 values each", "vertex colours need a COFF header"});
+  write_file(dir + "/two_coloured.off",
+             "COFF\n4 4 0\n0 0 0 1 1 1 1 10 0 0 1 1 1 1\n0 10 0 1 1 1 1\n0 0 10 1 1 1 1\n" + faces);
+  expect_input_error(
+      [&] { read_surface(dir + "/two_coloured.off"); },
+      {"line 3", "vertex 0 as 'x y z r g b [a]', one vertex per line (the line has 14 values)"});
+  write_file(dir + "/spill.off", "OFF\n3 1 0\n0 0 0 1 0 0\n0 1 0 3 0 1 2\n");
+  expect_input_error([&] { read_surface(dir + "/spill.off"); },
+                     {"line 4", "no more values after vertex 2, the last of the 3 the header announces"});
+  write_file(dir + "/two_faces.off", "OFF\n4 4 0\n0 0 0\n10 0 0\n0 10 0\n0 0 10\n3 0 2 1 3 0 1 3 3 0 3 2\n");
+  expect_input_error([&] { read_surface(dir + "/two_faces.off"); },
+                     {"line 7", "face 0 as 'k i_1 ... i_k [colour]' on a line of its own",
+                      "after its 3 indices come 8 values"});
+}
+
+// ASCII PLY records are read by the header's properties: several on a line were one record each, the rest
+// of the line dropped.
+TEST(SurfaceIo, AsciiPlyWithSeveralRecordsOnALine) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string faces = "3 0 2 1 3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const std::string dir = temp_dir();
+  write_file(dir + "/pairs.ply", header + "0 0 0 10 0 0\n0 10 0 0 0 10\n" + faces);
+  TriSurface s = read_surface(dir + "/pairs.ply");
+  ASSERT_EQ(s.vertices.size(), 4u);
+  EXPECT_EQ(s.vertices[3], (Vec3{0, 0, 10}));
+  EXPECT_TRUE(check_surface(s).usable());
+  // A record does not continue on the next line.
+  write_file(dir + "/split.ply", header + "0 0 0 10 0\n0 0 10 0 0 0 10\n" + faces);
+  expect_input_error(
+      [&] { read_surface(dir + "/split.ply"); },
+      {"line 10: vertex 1 (0-based) starts after value 3 of the line and the line ends inside it",
+       "its 5 values are not whole records"});
+  write_file(dir + "/more.ply",
+             header + "0 0 0 10 0 0\n0 10 0 0 0 10\n" + faces.substr(0, faces.size() - 1) + " 5\n");
+  expect_input_error([&] { read_surface(dir + "/more.ply"); },
+                     {"line 14: '5' after the elements the header announces"});
 }
 
 TEST(SurfaceIo, AsciiPlyWithExtraProperties) {
@@ -397,6 +486,81 @@ TEST(SurfaceIo, ObjByteOrderMarkAndUnderflow) {
   const TriSurface s = read_surface(dir + "/bom.obj");
   EXPECT_EQ(s.triangles.size(), 4u);
   EXPECT_EQ(s.vertices.at(3)[2], 0.0);
+}
+
+// OFF and PLY behind a UTF-8 byte order mark were refused ("expected the keyword OFF", "its first line must
+// be 'ply'") where OBJ and STL were read.
+TEST(SurfaceIo, OffAndPlyByteOrderMarkIsSkipped) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/bom.off", "\xEF\xBB\xBFOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(read_surface(dir + "/bom.off").triangles.size(), 1u);
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  write_file(dir + "/bom.ply", "\xEF\xBB\xBF" + header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(read_surface(dir + "/bom.ply").triangles.size(), 1u);
+  // Binary data starts after the header, wherever the mark put it.
+  const std::string path = dir + "/bom_binary.ply";
+  write_surface(path, subdivided_cube(1));
+  write_file(path, "\xEF\xBB\xBF" + read_file(path));
+  EXPECT_EQ(read_surface(path).triangles.size(), 12u);
+}
+
+// A backslash at the end of an OBJ line continues the statement on the next line (Wavefront spec): it was
+// "malformed OBJ face line 'f 1 3 \\'". Messages name the lines of a continued statement.
+TEST(SurfaceIo, ObjLineContinuation) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/joined.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 \\\n 1\nf 1 3 \\\n2\nf 1 2 4\nf 1 4 3\\  \r\n\nf 2 3 4\n");
+  const TriSurface s = read_surface(dir + "/joined.obj");
+  ASSERT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.vertices.at(3), (Vec3{0, 0, 1}));
+  EXPECT_EQ(s.triangles[0], (std::array<int, 3>{0, 2, 1}));
+  EXPECT_EQ(s.triangles[3], (std::array<int, 3>{1, 2, 3}));
+  write_file(dir + "/bad.obj", "v 0 0 0\nv 1 0 \\\nzero\nv 0 1 0\nf 1 2 x\n");
+  expect_input_error([&] { read_surface(dir + "/bad.obj"); },
+                     {"bad.obj' lines 2-3: malformed OBJ vertex line 'v 1 0 zero'"});
+  write_file(dir + "/bad2.obj", "v 0 0 0\nv 1 0 \\\n0\nv 0 1 0\nf 1 2 x\n");
+  expect_input_error([&] { read_surface(dir + "/bad2.obj"); }, {"bad2.obj' line 5: malformed OBJ face line"});
+}
+
+// A binary STL with bytes after its announced records: fewer than a record (a line end) are ignored with a
+// warning (it was "truncated or corrupt ... (extra 1)"); a record or more is a wrong count.
+TEST(SurfaceIo, BinaryStlWithTrailingBytes) {
+  const std::string path = temp_dir() + "/trailing.stl";
+  write_surface(path, subdivided_cube(1));  // 12 triangles: 684 bytes
+  const std::string bytes = read_file(path);
+  write_file(path, bytes + "\n");
+  testing::internal::CaptureStderr();
+  const TriSurface s = read_surface(path);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(s.triangles.size(), 12u);
+  EXPECT_NE(
+      err.find("hexbite: warning: '" + path +
+               "': its header announces 12 triangles, which take 84 + 50 x 12 = 684 bytes, but the file "
+               "has 685 bytes (1 more, less than a triangle record); the 12 triangles are read and the "
+               "extra bytes ignored"),
+      std::string::npos)
+      << err;
+  write_file(path, bytes + bytes.substr(84, 50));
+  expect_input_error([&] { read_surface(path); },
+                     {"is a corrupt binary STL: its header announces 12 triangles",
+                      "the file has 734 bytes, 50 more", "the count is wrong or other data was appended"});
+}
+
+// Counts beyond 2^31 - 1 were "expected the counts ... as non-negative integers".
+TEST(SurfaceIoErrors, CountsBeyondWhatIsReadAreNamed) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/big.off", "OFF\n4000000000 4 0\n0 0 0\n");
+  expect_input_error(
+      [&] { read_surface(dir + "/big.off"); },
+      {"big.off' line 2: the header announces 4000000000 vertices, more than hexbite reads (at "
+       "most 2147483647 = 2^31 - 1)"});
+  write_file(dir + "/big.ply",
+             "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n");
+  expect_input_error(
+      [&] { read_surface(dir + "/big.ply"); },
+      {"big.ply' line 3: 'element vertex' announces 4000000000 records, more than hexbite reads"});
 }
 
 // Coordinates of a kilometre and more: `surface check` called such a surface usable and wrote an STL of
