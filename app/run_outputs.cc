@@ -13,6 +13,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/markup_escape.h"
 #include "common/number_format.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
@@ -243,17 +244,17 @@ std::string pvtu_text(const std::vector<MeshArray>& cells, const std::vector<Mes
          "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
   out << "    <PPointData>\n";
   for (const MeshArray& a : points)
-    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\""
+    out << "      <PDataArray type=\"Float64\" Name=\"" << markup_escape(a.name) << "\" NumberOfComponents=\""
         << a.components << "\"/>\n";
   out << "    </PPointData>\n    <PCellData>\n";
   for (const char* name : kVtuQualityArrays)
     out << "      <PDataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"1\"/>\n";
   for (const MeshArray& a : cells)
-    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\""
+    out << "      <PDataArray type=\"Float64\" Name=\"" << markup_escape(a.name) << "\" NumberOfComponents=\""
         << a.components << "\"/>\n";
   out << "    </PCellData>\n    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
          "    </PPoints>\n";
-  for (const std::string& p : pieces) out << "    <Piece Source=\"" << p << "\"/>\n";
+  for (const std::string& p : pieces) out << "    <Piece Source=\"" << markup_escape(p) << "\"/>\n";
   out << "  </PUnstructuredGrid>\n</VTKFile>\n";
   return out.str();
 }

@@ -36,6 +36,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/markup_escape.h"
 #include "common/paths.h"
 #include "mesher/hex_quality.h"
 #include "mesher/vtk_messages.h"
@@ -169,7 +170,9 @@ bool is_64_bit_integer(const vtkDataArray& a) {
 vtkSmartPointer<vtkDataArray> make_vtk_array(const MeshArray& a) {
   vtkSmartPointer<vtkDataArray> array;
   array.TakeReference(vtkDataArray::CreateDataArray(a.vtk_type));
-  array->SetName(a.name.c_str());
+  // VTK 9.1's XML writer puts the name into its Name="..." attribute as it is: a name holding & < or "
+  // made a file that no XML reader accepts. Escaped here, it reads back as the name itself.
+  array->SetName(markup_escape(a.name).c_str());
   array->SetNumberOfComponents(a.components);
   array->SetNumberOfTuples(static_cast<vtkIdType>(a.values.size() / a.components));
   if (!a.bits64.empty() && is_64_bit_integer(*array) && a.bits64.size() == a.values.size()) {
