@@ -1,5 +1,6 @@
 #include "mesher/hex_mesh_io.h"
 
+#include <vtkCell.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkCellTypes.h>
@@ -297,14 +298,21 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   HexMesh mesh;
   mesh.vertices.resize(num_points);
   for (vtkIdType v = 0; v < num_points; ++v) grid->GetPoint(v, mesh.vertices[v].data());
-  mesh.hexes.resize(num_cells);
+  // Surface, line and point cells are skipped, as read_msh skips Gmsh's lower-dimensional elements (a mesh
+  // exported with its boundary quads); a vtkVoxel is a hexahedron whose nodes 2, 3 and 6, 7 come in the
+  // other order. `kept` lists the file's cells that became hexes, for the cell arrays.
+  std::vector<vtkIdType> kept;
   for (vtkIdType c = 0; c < num_cells; ++c) {
     const int type = grid->GetCellType(c);
-    if (type != VTK_HEXAHEDRON) {
+    if (type != VTK_HEXAHEDRON && type != VTK_VOXEL) {
+      if (grid->GetCell(c)->GetCellDimension() < 3) continue;
       const char* name = vtkCellTypes::GetClassNameFromTypeId(type);
       throw InputError(where + ": cell " + std::to_string(c) + " is a " + (name ? name : "unknown cell") +
                        " (VTK cell type " + std::to_string(type) +
-                       "); only hexahedra (VTK_HEXAHEDRON, type 12) are accepted");
+                       "); only hexahedra (VTK_HEXAHEDRON, type 12, or vtkVoxel, type 11) are accepted, "
+                       "surface cells skipped: give an all-hex mesh (in Gmsh, for instance "
+                       "Mesh.SubdivisionAlgorithm = 2, which splits every element into hexahedra, with "
+                       "Mesh.ElementOrder = 1), or mesh the surface with hexbite mesh");
     }
     vtkIdType npts = 0;
     const vtkIdType* pts = nullptr;
@@ -312,16 +320,38 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
     if (npts != 8)
       throw InputError(where + ": hexahedron " + std::to_string(c) + " has " + std::to_string(npts) +
                        " vertices instead of 8");
+    std::array<int, 8> hex;
     for (int k = 0; k < 8; ++k) {
       if (pts[k] < 0 || pts[k] >= num_points)
         throw InputError(where + ": hexahedron " + std::to_string(c) + " refers to vertex " +
                          std::to_string(pts[k]) + ", but there are only " + std::to_string(num_points) +
                          " vertices");
-      mesh.hexes[c][k] = static_cast<int>(pts[k]);
+      hex[k] = static_cast<int>(pts[k]);
     }
+    if (type == VTK_VOXEL) {
+      std::swap(hex[2], hex[3]);
+      std::swap(hex[6], hex[7]);
+    }
+    mesh.hexes.push_back(hex);
+    kept.push_back(c);
   }
   check_mesh(mesh, where);
-  if (cell_arrays != nullptr) *cell_arrays = arrays_of(grid->GetCellData());
+  if (cell_arrays != nullptr) {
+    *cell_arrays = arrays_of(grid->GetCellData());
+    if (kept.size() != static_cast<std::size_t>(num_cells))
+      for (MeshArray& a : *cell_arrays) {  // the values of the hexes only
+        const std::size_t n = static_cast<std::size_t>(a.components);
+        MeshArray hexes_only{a.name, a.components, {}, a.vtk_type, {}};
+        for (const vtkIdType c : kept) {
+          hexes_only.values.insert(hexes_only.values.end(), a.values.begin() + c * n,
+                                   a.values.begin() + (c + 1) * n);
+          if (!a.bits64.empty())
+            hexes_only.bits64.insert(hexes_only.bits64.end(), a.bits64.begin() + c * n,
+                                     a.bits64.begin() + (c + 1) * n);
+        }
+        a = std::move(hexes_only);
+      }
+  }
   if (point_arrays != nullptr) *point_arrays = arrays_of(grid->GetPointData());
   if (not_read != nullptr) {
     // Text arrays are left unread (update_xml_reader() disables them), and field data has no place here.

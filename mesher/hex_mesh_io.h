@@ -2,9 +2,10 @@
 // CalculiX .inp export; write_hex_mesh and read_hex_mesh choose among them by the file name.
 //
 // Input/output: a HexMesh in VTK node order plus optional named per-cell and per-point arrays. Writers are
-// atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
-// hexahedra and throw InputError naming the file and what is wrong: missing, unreadable, not a mesh of that
-// format, a cell that is not a hexahedron (with its index and type), no hexahedron at all, a NaN or infinite
+// atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers keep only
+// hexahedra (a VTU's vtkVoxel read as the hexahedron it is), skip surface, line and point cells, and throw
+// InputError naming the file and what is wrong: missing, unreadable, not a mesh of that format, another
+// volume cell (with its index and type), no hexahedron at all, a NaN or infinite
 // coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes), a
 // hexahedron listed twice, two distinct vertices of hexes at exactly the same place (hexes that touch without
 // sharing their nodes; unused points may coincide). Orientation is not checked here: that is the quality
@@ -55,7 +56,8 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
                const std::vector<MeshArray>& point_arrays = {});
 
 // Reads a .vtu file of hexahedra. When given, cell_arrays and point_arrays receive the file's numeric
-// arrays (as doubles with their VTK type, in file order; the quality arrays included), and `not_read` what
+// arrays (as doubles with their VTK type, in file order; the quality arrays included; cell arrays with the
+// values of the hexes only), and `not_read` what
 // the file holds beside them: "cell array 'label' (text)", "field data 'TimeValue'".
 HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
                  std::vector<MeshArray>* point_arrays = nullptr,

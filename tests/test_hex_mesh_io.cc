@@ -286,6 +286,34 @@ TEST(HexMeshIo, VtuArrayNamesVtkCannotReadAreNamed) {
   EXPECT_NE(find_array(cells, "E>nu"), nullptr);
 }
 
+// A .vtu with its boundary quads, or of voxels, was refused ("cell 1 is a vtkQuad"), where the .msh reader
+// skips boundary quads: surface cells are skipped (and their values of cell arrays), a voxel is read as the
+// hexahedron it is, and another volume cell is refused with what to do.
+TEST(HexMeshIo, VtuSurfaceCellsAreSkippedAndVoxelsRead) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/voxel.vtu", ascii_vtu(1, "11", "0 1 3 2 4 5 7 6", "8", kCubePoints, 8));
+  const HexMesh voxel = read_vtu(dir + "/voxel.vtu");
+  ASSERT_EQ(voxel.hexes.size(), 1u);
+  EXPECT_EQ(voxel.hexes[0], (std::array<int, 8>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_GT(compute_hex_quality(voxel).scaled_jacobian[0], 0.99);
+
+  std::string text = ascii_vtu(3, "9 12 5", "0 1 2 3 0 1 2 3 4 5 6 7 4 5 6", "4 12 15", kCubePoints, 8);
+  text.insert(text.find("<Points>"),
+              "<PointData></PointData><CellData><DataArray type=\"Int32\" "
+              "Name=\"region\" format=\"ascii\">5 9 6</DataArray></CellData>\n");
+  write_file(dir + "/with_quads.vtu", text);
+  std::vector<MeshArray> cells;
+  const HexMesh mesh = read_vtu(dir + "/with_quads.vtu", &cells);
+  ASSERT_EQ(mesh.hexes.size(), 1u);
+  ASSERT_NE(find_array(cells, "region"), nullptr);
+  EXPECT_EQ(find_array(cells, "region")->values, std::vector<double>{9});
+
+  write_file(dir + "/wedge.vtu", ascii_vtu(1, "13", "0 1 2 4 5 6", "6", kCubePoints, 8));
+  const std::string msg = test::message_of<InputError>([&] { read_vtu(dir + "/wedge.vtu"); });
+  EXPECT_NE(msg.find("cell 0 is a vtkWedge (VTK cell type 13); only hexahedra"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Mesh.SubdivisionAlgorithm = 2"), std::string::npos) << msg;
+}
+
 // Before, a file without hexahedra read as an empty mesh (quality printed n/a, refine wrote an empty mesh,
 // exit 0), a hex listing a vertex twice was measured as "inverted", and an oversized Gmsh node block ended
 // in std::bad_alloc (exit 1, neither file nor line named).
