@@ -91,7 +91,7 @@ json relative_change(const RunResult& r, double (*figure)(const ElasticitySoluti
 std::string set_name(const std::string& prefix, const std::string& name) {
   std::string out = prefix;
   for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? std::toupper(c) : '_';
-  return out.substr(0, 80);
+  return out.substr(0, 79);  // the longest that CalculiX prints (write_inp)
 }
 
 std::vector<int> patch_nodes(const MeshPatch& patch) {
@@ -312,7 +312,7 @@ void check_inp_exportable(const Scenario& scenario) {
       throw InputError(
           where.str() + ": " + what + " and " + it->second.first + " (line " +
           std::to_string(it->second.second.line) + ") get the same CalculiX set name " + set +
-          " (set names keep letters, digits and '_', in upper case, up to 80 characters), so the "
+          " (set names keep letters, digits and '_', in upper case, up to 79 characters), so the "
           "export would mix their nodes; rename one of them, or leave the export out (--export inp, "
           "outputs.inp)");
   };

@@ -374,12 +374,14 @@ namespace {
 
 void check_set(const IndexSet& set, std::size_t count, const char* kind, std::set<std::string>& names) {
   const std::string& n = set.name;
-  bool ok = !n.empty() && n.size() <= 80 && std::isalpha(static_cast<unsigned char>(n[0]));
+  // CalculiX takes 80 characters, but prints an 80-character name blank in model.dat's totals ("for set
+  // and time"); 79 print.
+  bool ok = !n.empty() && n.size() <= 79 && std::isalpha(static_cast<unsigned char>(n[0]));
   for (char ch : n) ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_');
   if (!ok)
     throw std::invalid_argument(
         "write_inp: " + std::string(kind) + " set name '" + n +
-        "' must start with a letter and hold only letters, digits and '_' (at most 80)");
+        "' must start with a letter and hold only letters, digits and '_' (at most 79)");
   std::string upper = n;
   for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   // Abaqus names are case-insensitive, so NAll would collide with the NALL set written for all nodes.

@@ -65,7 +65,8 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = 
 
 // Exports an Abaqus / CalculiX input deck: *NODE (NSET=NALL), *ELEMENT TYPE=C3D8 (ELSET=EALL; the C3D8 node
 // order is VTK's hexahedron order), then one *NSET / *ELSET per given set. Numbers are 1-based in the file.
-// Set names must start with a letter and hold only letters, digits and '_' (at most 80 characters), and
+// Set names must start with a letter and hold only letters, digits and '_' (at most 79 characters:
+// CalculiX prints an 80-character one blank), and
 // may not be NALL or EALL; violations throw std::invalid_argument. No material or step: the solver adds them.
 void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<IndexSet>& node_sets = {},
                const std::vector<IndexSet>& element_sets = {});

@@ -556,6 +556,9 @@ TEST(HexMeshIo, InpExport) {
 
   EXPECT_THROW(write_inp(path, mesh, {{"1bad", {0}}}), std::invalid_argument);
   EXPECT_THROW(write_inp(path, mesh, {{"nall", {0}}}), std::invalid_argument);
+  // CalculiX printed an 80-character set name blank in model.dat ("total force ... for set  and time").
+  EXPECT_NO_THROW(write_inp(path, mesh, {{std::string(79, 'A'), {0}}}));
+  EXPECT_THROW(write_inp(path, mesh, {{std::string(80, 'A'), {0}}}), std::invalid_argument);
   EXPECT_THROW(write_inp(path, mesh, {}, {{"E", {12}}}), std::invalid_argument);
 }
 
