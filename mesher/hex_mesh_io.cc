@@ -653,6 +653,7 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
     hex_tags.push_back(tag);
   };
 
+  std::map<std::pair<int, long>, std::string> physical;  // (dimension, tag) -> name, "" for none
   while (r.next_line(line)) {
     if (line == "$MeshFormat") {
       auto s = r.numbers();
@@ -663,6 +664,39 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
       if (file_type != 0) r.fail("binary .msh files are not supported; save the mesh as ASCII");
       r.expect_end("MeshFormat");
       have_format = true;
+    } else if (line == "$PhysicalNames") {
+      auto s = r.numbers();
+      long count = 0;
+      r.read(s, count);
+      for (long i = 0; i < count; ++i) {
+        if (!r.next_line(line)) r.fail("expected a physical name");
+        std::istringstream ps(line);
+        int dim = 0;
+        long tag = 0;
+        ps >> dim >> tag;
+        const std::size_t open = line.find('"'), close = line.rfind('"');
+        physical[{dim, tag}] = open < close ? line.substr(open + 1, close - open - 1) : "";
+      }
+      r.expect_end("PhysicalNames");
+    } else if (line == "$Entities" && version == "4.1") {
+      // Points "tag x y z", then curves, surfaces and volumes "tag minX minY minZ maxX maxY maxZ", each
+      // followed by its physical tags "count tag ...".
+      auto s = r.numbers();
+      long counts[4] = {0, 0, 0, 0};
+      r.read(s, counts[0], counts[1], counts[2], counts[3]);
+      for (int dim = 0; dim < 4; ++dim)
+        for (long i = 0; i < counts[dim]; ++i) {
+          auto es = r.numbers();
+          double skip = 0;
+          for (int k = 0; k < (dim == 0 ? 4 : 7); ++k) r.read(es, skip);
+          long n = 0, tag = 0;
+          r.read(es, n);
+          for (long k = 0; k < n; ++k) {
+            r.read(es, tag);
+            physical.emplace(std::make_pair(dim, std::labs(tag)), "");
+          }
+        }
+      r.expect_end("Entities");
     } else if (line == "$Nodes" || line == "$ParametricNodes") {
       // MSH 2.2 with Mesh.SaveParametric writes $ParametricNodes: "tag x y z dim entity" and up to two
       // parametric coordinates, which the 2.2 branch below leaves unread (4.1 keeps them in $Nodes).
@@ -747,7 +781,10 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
           long tag = 0, v = 0;
           int type = 0, num_tags = 0;
           r.read(es, tag, type, num_tags);
-          for (int t = 0; t < num_tags; ++t) r.read(es, v);
+          for (int t = 0; t < num_tags; ++t) {
+            r.read(es, v);
+            if (t == 0 && v != 0) physical.emplace(std::make_pair(gmsh_element_dimension(type), v), "");
+          }
           nodes.clear();
           while (es >> v) nodes.push_back(v);
           add_element(tag, type, nodes);
@@ -760,7 +797,14 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
   if (!have_format) r.fail("no $MeshFormat section: not a Gmsh .msh file");
   if (!have_elements) r.fail("no $Elements section");
   check_mesh(mesh, "Gmsh mesh '" + path + "'", node_tags);
-  if (tags != nullptr) *tags = {std::move(node_tags), std::move(hex_tags)};
+  if (tags != nullptr) {
+    *tags = {std::move(node_tags), std::move(hex_tags), {}};
+    for (const auto& [key, name] : physical)
+      tags->physical_groups.push_back("physical group " +
+                                      (name.empty() ? std::to_string(key.second) : "'" + name + "'") + " (" +
+                                      std::to_string(key.first) + "-D" +
+                                      (name.empty() ? "" : ", tag " + std::to_string(key.second)) + ")");
+  }
   return mesh;
 }
 

@@ -84,12 +84,15 @@ void write_msh(const std::string& path, const HexMesh& mesh);
 struct GmshTags {
   std::vector<long> nodes;
   std::vector<long> elements;
+  // The file's physical groups, which no writer carries over: "physical group 'bone' (3-D, tag 1)", or
+  // "physical group 2 (2-D)" for one without a name.
+  std::vector<std::string> physical_groups;
 };
 
 // Reads a Gmsh ASCII .msh file, format 4.1 or 2.2 (its nodes in $Nodes, or in 2.2 $ParametricNodes).
 // Points, lines and faces are skipped; hexahedra (type 5) are kept; any other volume element is an
 // InputError. All nodes are kept, in the file's order. When given, `tags` receives the file's node and
-// element tags.
+// element tags and its physical groups (from $PhysicalNames, 4.1's $Entities and 2.2's element tags).
 HexMesh read_msh(const std::string& path, GmshTags* tags = nullptr);
 
 // The hex mesh formats by the file name's extension (any case): .vtu (write_vtu, with the arrays), .inp

@@ -665,6 +665,41 @@ TEST(HexMeshIo, MshVersion22WithLowerDimensionalElements) {
             std::string::npos);
 }
 
+// Gmsh physical groups were dropped without a word by reorder and refine (a .vtu input's arrays get a
+// warning): they are read, with their names, and named in a warning.
+TEST(HexMeshIo, MshPhysicalGroupsAreNamedWhenNotCarriedOver) {
+  const std::string dir = temp_dir();
+  write_file(
+      dir + "/v22.msh",
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n2 5 \"floor\"\n3 1 \"cortical bone\"\n"
+      "$EndPhysicalNames\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n"
+      "8 0 1 1\n$EndNodes\n$Elements\n2\n1 3 2 5 1 1 4 3 2\n2 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n");
+  GmshTags tags;
+  read_msh(dir + "/v22.msh", &tags);
+  EXPECT_EQ(tags.physical_groups, (std::vector<std::string>{"physical group 'floor' (2-D, tag 5)",
+                                                            "physical group 'cortical bone' (3-D, tag 1)"}));
+  write_file(dir + "/v41.msh",
+             "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 1 7 0\n$EndEntities\n"
+             "$Nodes\n1 8 1 8\n3 1 0 8\n1\n2\n3\n4\n5\n6\n7\n8\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n"
+             "1 1 1\n0 1 1\n$EndNodes\n$Elements\n1 1 1 1\n3 1 5 1\n1 1 2 3 4 5 6 7 8\n$EndElements\n");
+  read_msh(dir + "/v41.msh", &tags);
+  EXPECT_EQ(tags.physical_groups, std::vector<std::string>{"physical group 7 (3-D)"});
+  // hexbite's own .msh has none.
+  write_msh(dir + "/own.msh", make_block_mesh(1, 1, 1));
+  read_msh(dir + "/own.msh", &tags);
+  EXPECT_TRUE(tags.physical_groups.empty());
+
+  for (const char* command : {"reorder", "refine"}) {
+    const auto r = run_hexbite({command, dir + "/v22.msh", "-o", dir + "/out.msh", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: not carried over to " + dir +
+                         "/out.msh: physical group 'floor' (2-D, tag 5), "
+                         "physical group 'cortical bone' (3-D, tag 1)"),
+              std::string::npos)
+        << command << ": " << r.err;
+  }
+}
+
 // Two hexes that touch but do not share their corner nodes (two Gmsh volumes meshed without Coherence Mesh)
 // were read as one mesh: quality counted the face between them as boundary and refine --surface moved its
 // nodes onto the surface, so the halves overlapped. Unused points may still coincide.
