@@ -223,6 +223,7 @@ void run_refine(const RefineCliOptions& o) {
   const HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
   const bool valid = report.after.inverted == 0;
   if (valid) write_hex_mesh(o.output, fine);
+  if (valid) input.warn_physical_groups_not_carried(o.mesh, o.output, "refine");
 
   if (o.json)
     std::cout << json_text(report_json(o, report, valid)) << '\n';

@@ -189,6 +189,7 @@ void run_reorder(const ReorderOptions& o) {
   write_hex_mesh(o.output, r.mesh, permute_arrays(cells.own, r.hex_order),
                  permute_arrays(point_arrays, r.node_order));
   warn_arrays_not_carried(o, cells, point_arrays, not_read);
+  input.warn_physical_groups_not_carried(o.mesh, o.output, "reorder");
 
   if (o.json) {
     nlohmann::json j;

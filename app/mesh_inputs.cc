@@ -67,6 +67,15 @@ QuadSurface load_quad_surface_input(const std::string& path) {
   return surface;
 }
 
+void HexMeshInput::warn_physical_groups_not_carried(const std::string& path, const std::string& output,
+                                                    const std::string& command) const {
+  if (gmsh.physical_groups.empty()) return;
+  std::string list;
+  for (const std::string& group : gmsh.physical_groups) list += (list.empty() ? "" : ", ") + group;
+  std::cerr << "hexbite: warning: not carried over to " << output << ": " << list << " of " << path << " ("
+            << command << " writes no physical groups; define them again on its mesh).\n";
+}
+
 HexMeshInput load_hex_mesh_input(const std::string& path, std::vector<MeshArray>* cell_arrays,
                                  std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
   HexMeshInput in;

@@ -42,6 +42,10 @@ struct HexMeshInput {
   // For hex_list_text(): " (Gmsh element 9)" after hex h's 0-based number, as Gmsh names the hex; an empty
   // function for a .vtu, whose hexes ParaView numbers 0-based as hexbite does. Valid while this lives.
   std::function<std::string(int)> hex_label() const;
+  // A warning on standard error naming the physical groups of a .msh input, which no output of `command`
+  // (refine, reorder) to `output` carries; nothing when there are none.
+  void warn_physical_groups_not_carried(const std::string& path, const std::string& output,
+                                        const std::string& command) const;
 };
 
 // Reads the hex mesh `path` (read_hex_mesh, with the arrays when asked for) and warns on standard error

@@ -13,6 +13,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/markup_escape.h"
 #include "common/number_format.h"
 #include "mesher/grid_mesher.h"
 #include "mesher/hex_mesh_io.h"
@@ -90,7 +91,7 @@ json relative_change(const RunResult& r, double (*figure)(const ElasticitySoluti
 std::string set_name(const std::string& prefix, const std::string& name) {
   std::string out = prefix;
   for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? std::toupper(c) : '_';
-  return out.substr(0, 80);
+  return out.substr(0, 79);  // the longest that CalculiX prints (write_inp)
 }
 
 std::vector<int> patch_nodes(const MeshPatch& patch) {
@@ -243,17 +244,17 @@ std::string pvtu_text(const std::vector<MeshArray>& cells, const std::vector<Mes
          "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
   out << "    <PPointData>\n";
   for (const MeshArray& a : points)
-    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\""
+    out << "      <PDataArray type=\"Float64\" Name=\"" << markup_escape(a.name) << "\" NumberOfComponents=\""
         << a.components << "\"/>\n";
   out << "    </PPointData>\n    <PCellData>\n";
   for (const char* name : kVtuQualityArrays)
     out << "      <PDataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"1\"/>\n";
   for (const MeshArray& a : cells)
-    out << "      <PDataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\""
+    out << "      <PDataArray type=\"Float64\" Name=\"" << markup_escape(a.name) << "\" NumberOfComponents=\""
         << a.components << "\"/>\n";
   out << "    </PCellData>\n    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
          "    </PPoints>\n";
-  for (const std::string& p : pieces) out << "    <Piece Source=\"" << p << "\"/>\n";
+  for (const std::string& p : pieces) out << "    <Piece Source=\"" << markup_escape(p) << "\"/>\n";
   out << "  </PUnstructuredGrid>\n</VTKFile>\n";
   return out.str();
 }
@@ -311,7 +312,7 @@ void check_inp_exportable(const Scenario& scenario) {
       throw InputError(
           where.str() + ": " + what + " and " + it->second.first + " (line " +
           std::to_string(it->second.second.line) + ") get the same CalculiX set name " + set +
-          " (set names keep letters, digits and '_', in upper case, up to 80 characters), so the "
+          " (set names keep letters, digits and '_', in upper case, up to 79 characters), so the "
           "export would mix their nodes; rename one of them, or leave the export out (--export inp, "
           "outputs.inp)");
   };

@@ -1,5 +1,6 @@
 #include "mesher/hex_mesh_io.h"
 
+#include <vtkCell.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkCellTypes.h>
@@ -36,6 +37,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/markup_escape.h"
 #include "common/paths.h"
 #include "mesher/hex_quality.h"
 #include "mesher/vtk_messages.h"
@@ -169,7 +171,9 @@ bool is_64_bit_integer(const vtkDataArray& a) {
 vtkSmartPointer<vtkDataArray> make_vtk_array(const MeshArray& a) {
   vtkSmartPointer<vtkDataArray> array;
   array.TakeReference(vtkDataArray::CreateDataArray(a.vtk_type));
-  array->SetName(a.name.c_str());
+  // VTK 9.1's XML writer puts the name into its Name="..." attribute as it is: a name holding & < or "
+  // made a file that no XML reader accepts. Escaped here, it reads back as the name itself.
+  array->SetName(markup_escape(a.name).c_str());
   array->SetNumberOfComponents(a.components);
   array->SetNumberOfTuples(static_cast<vtkIdType>(a.values.size() / a.components));
   if (!a.bits64.empty() && is_64_bit_integer(*array) && a.bits64.size() == a.values.size()) {
@@ -294,14 +298,21 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   HexMesh mesh;
   mesh.vertices.resize(num_points);
   for (vtkIdType v = 0; v < num_points; ++v) grid->GetPoint(v, mesh.vertices[v].data());
-  mesh.hexes.resize(num_cells);
+  // Surface, line and point cells are skipped, as read_msh skips Gmsh's lower-dimensional elements (a mesh
+  // exported with its boundary quads); a vtkVoxel is a hexahedron whose nodes 2, 3 and 6, 7 come in the
+  // other order. `kept` lists the file's cells that became hexes, for the cell arrays.
+  std::vector<vtkIdType> kept;
   for (vtkIdType c = 0; c < num_cells; ++c) {
     const int type = grid->GetCellType(c);
-    if (type != VTK_HEXAHEDRON) {
+    if (type != VTK_HEXAHEDRON && type != VTK_VOXEL) {
+      if (grid->GetCell(c)->GetCellDimension() < 3) continue;
       const char* name = vtkCellTypes::GetClassNameFromTypeId(type);
       throw InputError(where + ": cell " + std::to_string(c) + " is a " + (name ? name : "unknown cell") +
                        " (VTK cell type " + std::to_string(type) +
-                       "); only hexahedra (VTK_HEXAHEDRON, type 12) are accepted");
+                       "); only hexahedra (VTK_HEXAHEDRON, type 12, or vtkVoxel, type 11) are accepted, "
+                       "surface cells skipped: give an all-hex mesh (in Gmsh, for instance "
+                       "Mesh.SubdivisionAlgorithm = 2, which splits every element into hexahedra, with "
+                       "Mesh.ElementOrder = 1), or mesh the surface with hexbite mesh");
     }
     vtkIdType npts = 0;
     const vtkIdType* pts = nullptr;
@@ -309,16 +320,38 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
     if (npts != 8)
       throw InputError(where + ": hexahedron " + std::to_string(c) + " has " + std::to_string(npts) +
                        " vertices instead of 8");
+    std::array<int, 8> hex;
     for (int k = 0; k < 8; ++k) {
       if (pts[k] < 0 || pts[k] >= num_points)
         throw InputError(where + ": hexahedron " + std::to_string(c) + " refers to vertex " +
                          std::to_string(pts[k]) + ", but there are only " + std::to_string(num_points) +
                          " vertices");
-      mesh.hexes[c][k] = static_cast<int>(pts[k]);
+      hex[k] = static_cast<int>(pts[k]);
     }
+    if (type == VTK_VOXEL) {
+      std::swap(hex[2], hex[3]);
+      std::swap(hex[6], hex[7]);
+    }
+    mesh.hexes.push_back(hex);
+    kept.push_back(c);
   }
   check_mesh(mesh, where);
-  if (cell_arrays != nullptr) *cell_arrays = arrays_of(grid->GetCellData());
+  if (cell_arrays != nullptr) {
+    *cell_arrays = arrays_of(grid->GetCellData());
+    if (kept.size() != static_cast<std::size_t>(num_cells))
+      for (MeshArray& a : *cell_arrays) {  // the values of the hexes only
+        const std::size_t n = static_cast<std::size_t>(a.components);
+        MeshArray hexes_only{a.name, a.components, {}, a.vtk_type, {}};
+        for (const vtkIdType c : kept) {
+          hexes_only.values.insert(hexes_only.values.end(), a.values.begin() + c * n,
+                                   a.values.begin() + (c + 1) * n);
+          if (!a.bits64.empty())
+            hexes_only.bits64.insert(hexes_only.bits64.end(), a.bits64.begin() + c * n,
+                                     a.bits64.begin() + (c + 1) * n);
+        }
+        a = std::move(hexes_only);
+      }
+  }
   if (point_arrays != nullptr) *point_arrays = arrays_of(grid->GetPointData());
   if (not_read != nullptr) {
     // Text arrays are left unread (update_xml_reader() disables them), and field data has no place here.
@@ -341,12 +374,14 @@ namespace {
 
 void check_set(const IndexSet& set, std::size_t count, const char* kind, std::set<std::string>& names) {
   const std::string& n = set.name;
-  bool ok = !n.empty() && n.size() <= 80 && std::isalpha(static_cast<unsigned char>(n[0]));
+  // CalculiX takes 80 characters, but prints an 80-character name blank in model.dat's totals ("for set
+  // and time"); 79 print.
+  bool ok = !n.empty() && n.size() <= 79 && std::isalpha(static_cast<unsigned char>(n[0]));
   for (char ch : n) ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_');
   if (!ok)
     throw std::invalid_argument(
         "write_inp: " + std::string(kind) + " set name '" + n +
-        "' must start with a letter and hold only letters, digits and '_' (at most 80)");
+        "' must start with a letter and hold only letters, digits and '_' (at most 79)");
   std::string upper = n;
   for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   // Abaqus names are case-insensitive, so NAll would collide with the NALL set written for all nodes.
@@ -618,6 +653,7 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
     hex_tags.push_back(tag);
   };
 
+  std::map<std::pair<int, long>, std::string> physical;  // (dimension, tag) -> name, "" for none
   while (r.next_line(line)) {
     if (line == "$MeshFormat") {
       auto s = r.numbers();
@@ -628,6 +664,39 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
       if (file_type != 0) r.fail("binary .msh files are not supported; save the mesh as ASCII");
       r.expect_end("MeshFormat");
       have_format = true;
+    } else if (line == "$PhysicalNames") {
+      auto s = r.numbers();
+      long count = 0;
+      r.read(s, count);
+      for (long i = 0; i < count; ++i) {
+        if (!r.next_line(line)) r.fail("expected a physical name");
+        std::istringstream ps(line);
+        int dim = 0;
+        long tag = 0;
+        ps >> dim >> tag;
+        const std::size_t open = line.find('"'), close = line.rfind('"');
+        physical[{dim, tag}] = open < close ? line.substr(open + 1, close - open - 1) : "";
+      }
+      r.expect_end("PhysicalNames");
+    } else if (line == "$Entities" && version == "4.1") {
+      // Points "tag x y z", then curves, surfaces and volumes "tag minX minY minZ maxX maxY maxZ", each
+      // followed by its physical tags "count tag ...".
+      auto s = r.numbers();
+      long counts[4] = {0, 0, 0, 0};
+      r.read(s, counts[0], counts[1], counts[2], counts[3]);
+      for (int dim = 0; dim < 4; ++dim)
+        for (long i = 0; i < counts[dim]; ++i) {
+          auto es = r.numbers();
+          double skip = 0;
+          for (int k = 0; k < (dim == 0 ? 4 : 7); ++k) r.read(es, skip);
+          long n = 0, tag = 0;
+          r.read(es, n);
+          for (long k = 0; k < n; ++k) {
+            r.read(es, tag);
+            physical.emplace(std::make_pair(dim, std::labs(tag)), "");
+          }
+        }
+      r.expect_end("Entities");
     } else if (line == "$Nodes" || line == "$ParametricNodes") {
       // MSH 2.2 with Mesh.SaveParametric writes $ParametricNodes: "tag x y z dim entity" and up to two
       // parametric coordinates, which the 2.2 branch below leaves unread (4.1 keeps them in $Nodes).
@@ -712,7 +781,10 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
           long tag = 0, v = 0;
           int type = 0, num_tags = 0;
           r.read(es, tag, type, num_tags);
-          for (int t = 0; t < num_tags; ++t) r.read(es, v);
+          for (int t = 0; t < num_tags; ++t) {
+            r.read(es, v);
+            if (t == 0 && v != 0) physical.emplace(std::make_pair(gmsh_element_dimension(type), v), "");
+          }
           nodes.clear();
           while (es >> v) nodes.push_back(v);
           add_element(tag, type, nodes);
@@ -725,7 +797,14 @@ HexMesh read_msh(const std::string& path, GmshTags* tags) {
   if (!have_format) r.fail("no $MeshFormat section: not a Gmsh .msh file");
   if (!have_elements) r.fail("no $Elements section");
   check_mesh(mesh, "Gmsh mesh '" + path + "'", node_tags);
-  if (tags != nullptr) *tags = {std::move(node_tags), std::move(hex_tags)};
+  if (tags != nullptr) {
+    *tags = {std::move(node_tags), std::move(hex_tags), {}};
+    for (const auto& [key, name] : physical)
+      tags->physical_groups.push_back("physical group " +
+                                      (name.empty() ? std::to_string(key.second) : "'" + name + "'") + " (" +
+                                      std::to_string(key.first) + "-D" +
+                                      (name.empty() ? "" : ", tag " + std::to_string(key.second)) + ")");
+  }
   return mesh;
 }
 

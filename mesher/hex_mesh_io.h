@@ -2,9 +2,10 @@
 // CalculiX .inp export; write_hex_mesh and read_hex_mesh choose among them by the file name.
 //
 // Input/output: a HexMesh in VTK node order plus optional named per-cell and per-point arrays. Writers are
-// atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers accept only
-// hexahedra and throw InputError naming the file and what is wrong: missing, unreadable, not a mesh of that
-// format, a cell that is not a hexahedron (with its index and type), no hexahedron at all, a NaN or infinite
+// atomic (a temporary file renamed into place) and deterministic (same mesh, same bytes). Readers keep only
+// hexahedra (a VTU's vtkVoxel read as the hexahedron it is), skip surface, line and point cells, and throw
+// InputError naming the file and what is wrong: missing, unreadable, not a mesh of that format, another
+// volume cell (with its index and type), no hexahedron at all, a NaN or infinite
 // coordinate, a vertex index out of range, a hexahedron listing a vertex twice (collapsed hexes), a
 // hexahedron listed twice, two distinct vertices of hexes at exactly the same place (hexes that touch without
 // sharing their nodes; unused points may coincide). Orientation is not checked here: that is the quality
@@ -55,7 +56,8 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
                const std::vector<MeshArray>& point_arrays = {});
 
 // Reads a .vtu file of hexahedra. When given, cell_arrays and point_arrays receive the file's numeric
-// arrays (as doubles with their VTK type, in file order; the quality arrays included), and `not_read` what
+// arrays (as doubles with their VTK type, in file order; the quality arrays included; cell arrays with the
+// values of the hexes only), and `not_read` what
 // the file holds beside them: "cell array 'label' (text)", "field data 'TimeValue'".
 HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = nullptr,
                  std::vector<MeshArray>* point_arrays = nullptr,
@@ -63,7 +65,8 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays = 
 
 // Exports an Abaqus / CalculiX input deck: *NODE (NSET=NALL), *ELEMENT TYPE=C3D8 (ELSET=EALL; the C3D8 node
 // order is VTK's hexahedron order), then one *NSET / *ELSET per given set. Numbers are 1-based in the file.
-// Set names must start with a letter and hold only letters, digits and '_' (at most 80 characters), and
+// Set names must start with a letter and hold only letters, digits and '_' (at most 79 characters:
+// CalculiX prints an 80-character one blank), and
 // may not be NALL or EALL; violations throw std::invalid_argument. No material or step: the solver adds them.
 void write_inp(const std::string& path, const HexMesh& mesh, const std::vector<IndexSet>& node_sets = {},
                const std::vector<IndexSet>& element_sets = {});
@@ -81,12 +84,15 @@ void write_msh(const std::string& path, const HexMesh& mesh);
 struct GmshTags {
   std::vector<long> nodes;
   std::vector<long> elements;
+  // The file's physical groups, which no writer carries over: "physical group 'bone' (3-D, tag 1)", or
+  // "physical group 2 (2-D)" for one without a name.
+  std::vector<std::string> physical_groups;
 };
 
 // Reads a Gmsh ASCII .msh file, format 4.1 or 2.2 (its nodes in $Nodes, or in 2.2 $ParametricNodes).
 // Points, lines and faces are skipped; hexahedra (type 5) are kept; any other volume element is an
 // InputError. All nodes are kept, in the file's order. When given, `tags` receives the file's node and
-// element tags.
+// element tags and its physical groups (from $PhysicalNames, 4.1's $Entities and 2.2's element tags).
 HexMesh read_msh(const std::string& path, GmshTags* tags = nullptr);
 
 // The hex mesh formats by the file name's extension (any case): .vtu (write_vtu, with the arrays), .inp

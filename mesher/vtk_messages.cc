@@ -1,6 +1,8 @@
 #include "mesher/vtk_messages.h"
 
 #include <vtkDataArraySelection.h>
+#include <vtkLZ4DataCompressor.h>
+#include <vtkLZMADataCompressor.h>
 #include <vtkLogger.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
@@ -9,6 +11,7 @@
 #include <vtkXMLDataElement.h>
 #include <vtkXMLDataParser.h>
 #include <vtkXMLReader.h>
+#include <vtkZLibDataCompressor.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -54,7 +57,7 @@ void disable_string_arrays(vtkXMLDataElement* e, vtkXMLReader* reader) {
 }
 
 // Whether a <Piece> below e has a <CellData> but no <PointData> element, and the name of its first data
-// array without a Name attribute (in `unnamed`, as "CellData of piece 0"), if any.
+// array without a name (in `unnamed`, as "CellData of piece 0"), if any.
 bool cell_data_without_point_data(vtkXMLDataElement* e, std::string* unnamed, int* piece) {
   bool found = false;
   for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
@@ -70,7 +73,8 @@ bool cell_data_without_point_data(vtkXMLDataElement* e, std::string* unnamed, in
     for (const char* data : {"PointData", "CellData"})
       if (vtkXMLDataElement* arrays = child->FindNestedElementWithName(data))
         for (int k = 0; k < arrays->GetNumberOfNestedElements() && unnamed->empty(); ++k)
-          if (arrays->GetNestedElement(k)->GetAttribute("Name") == nullptr)
+          if (const char* array_name = arrays->GetNestedElement(k)->GetAttribute("Name");
+              array_name == nullptr || *array_name == '\0')
             *unnamed = std::string("<") + data + "> of piece " + std::to_string(*piece);
     ++*piece;
   }
@@ -128,11 +132,17 @@ void check_piece_counts(vtkXMLDataElement* e, const std::string& file) {
   }
 }
 
-// A data array in the appended section: its offset, name, and the bytes its data must have uncompressed
-// (-1 when the piece's counts do not say, as for a cell connectivity).
-struct AppendedArray {
+// A data array of a piece: its element, where it is stored (format "ascii", "binary" or "appended"), its
+// offset in the appended section, its name ("points" for the coordinates), the section it sits in
+// (Points, PointData, CellData, Cells), and the values and bytes its data must have uncompressed (-1 when
+// the piece's counts do not say, as for a cell connectivity or a text array).
+struct DataArrayEntry {
+  vtkXMLDataElement* element = nullptr;
+  std::string format;
   long long offset = -1;
   std::string name;
+  std::string section;
+  long long values = -1;
   long long bytes = -1;
 };
 
@@ -151,20 +161,24 @@ long long type_size(const char* type) {
   return -1;
 }
 
-// The arrays below e stored in the appended section; `piece` and `section` are e's <Piece> and the element
-// the arrays sit in (Points, PointData, CellData, Cells).
-void appended_arrays(vtkXMLDataElement* e, vtkXMLDataElement* piece, const std::string& section,
-                     std::vector<AppendedArray>& out) {
+// The data arrays below e; `piece` and `section` are e's <Piece> and the element the arrays sit in (Points,
+// PointData, CellData, Cells).
+void data_arrays(vtkXMLDataElement* e, vtkXMLDataElement* piece, const std::string& section,
+                 std::vector<DataArrayEntry>& out) {
   for (int i = 0; i < e->GetNumberOfNestedElements(); ++i) {
     vtkXMLDataElement* child = e->GetNestedElement(i);
     const std::string name = child->GetName() != nullptr ? child->GetName() : "";
-    const char* format = child->GetAttribute("format");
-    if (name == "DataArray" && format != nullptr && std::strcmp(format, "appended") == 0) {
-      AppendedArray a;
+    if (name == "DataArray") {
+      DataArrayEntry a;
+      a.element = child;
+      a.format = child->GetAttribute("format") ? child->GetAttribute("format") : "";
+      a.section = section;
       errno = 0;
       a.offset = attribute_count(child, "offset");
       if (errno == ERANGE) a.offset = -1;
-      a.name = child->GetAttribute("Name") ? child->GetAttribute("Name") : "(unnamed)";
+      a.name = child->GetAttribute("Name") ? child->GetAttribute("Name")
+               : section == "Points"       ? "points"
+                                           : "(unnamed)";
       const long long points = attribute_count(piece, "NumberOfPoints"),
                       cells = attribute_count(piece, "NumberOfCells");
       long long tuples = -1;
@@ -172,16 +186,24 @@ void appended_arrays(vtkXMLDataElement* e, vtkXMLDataElement* piece, const std::
       if (section == "CellData" || (section == "Cells" && a.name != "connectivity")) tuples = cells;
       const long long components = std::max(1LL, attribute_count(child, "NumberOfComponents"));
       const long long size = type_size(child->GetAttribute("type"));
-      if (tuples >= 0 && size > 0) a.bytes = tuples * components * size;
+      if (tuples >= 0 && size > 0) {
+        a.values = tuples * components;
+        a.bytes = a.values * size;
+      }
       out.push_back(a);
       continue;
     }
-    appended_arrays(child, name == "Piece" ? child : piece,
-                    name == "Piece" ? ""
-                    : name.empty()  ? section
-                                    : name,
-                    out);
+    data_arrays(child, name == "Piece" ? child : piece,
+                name == "Piece" ? ""
+                : name.empty()  ? section
+                                : name,
+                out);
   }
+}
+
+InputError damaged_array(const std::string& file, const std::string& name, const std::string& what) {
+  return InputError("cannot read '" + file + "': the data of its array '" + name + "' " + what +
+                    "; the file is damaged (an offset or a size in it is wrong): export it again");
 }
 
 // Throws when a data array's block in the raw appended section does not lie within the file: VTK 9.1 reads a
@@ -190,8 +212,11 @@ void appended_arrays(vtkXMLDataElement* e, vtkXMLDataElement* piece, const std::
 // compressed: the number of blocks, their size, the last one's size and each block's compressed size, in
 // the file's header_type) followed by the bytes it announces. Hand-written: VTK has no check of its own.
 void check_appended_blocks(vtkXMLDataElement* root, const std::string& file) {
-  std::vector<AppendedArray> arrays;
-  appended_arrays(root, nullptr, "", arrays);
+  std::vector<DataArrayEntry> arrays;
+  data_arrays(root, nullptr, "", arrays);
+  arrays.erase(std::remove_if(arrays.begin(), arrays.end(),
+                              [](const DataArrayEntry& a) { return a.format != "appended"; }),
+               arrays.end());
   if (arrays.empty()) return;
   std::ifstream in(file, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -214,11 +239,9 @@ void check_appended_blocks(vtkXMLDataElement* root, const std::string& file) {
   };
   const char* byte_order = root->GetAttribute("byte_order");
   if (byte_order != nullptr && std::strcmp(byte_order, "LittleEndian") != 0) return;
-  for (const auto& [offset, name, expected] : arrays) {
-    const auto damaged = [&](const std::string& what) {
-      return InputError("cannot read '" + file + "': the data of its array '" + name + "' " + what +
-                        "; the file is damaged (an offset or a size in it is wrong): export it again");
-    };
+  for (const DataArrayEntry& a : arrays) {
+    const long long offset = a.offset, expected = a.bytes;
+    const auto damaged = [&](const std::string& what) { return damaged_array(file, a.name, what); };
     if (offset < 0 || data + static_cast<unsigned long long>(offset) + word > end)
       throw damaged("would start at offset " + std::to_string(offset) + ", beyond the appended data's " +
                     std::to_string(end - data) + " bytes");
@@ -244,6 +267,83 @@ void check_appended_blocks(vtkXMLDataElement* root, const std::string& file) {
     if (payload > end - at)
       throw damaged("announces " + std::to_string(payload) + " bytes where " + std::to_string(end - at) +
                     " remain in the file");
+  }
+}
+
+// Throws when an array stored in the file's XML (format "ascii" or base64 "binary") or in a base64 appended
+// section holds more or fewer values than its piece's counts give: VTK 9.1 reads as many as the counts say
+// and ignores the rest, so a file whose NumberOfCells was 1 too small lost its last hexes without a word.
+// (A raw appended section is checked by check_appended_blocks.) The data is read in chunks, each one
+// starting a word before the previous one ended, so that no read starts at the data's end: VTK's reader of
+// compressed data then looks up a block beyond its table.
+void check_array_lengths(vtkXMLDataElement* reader_root, const std::string& file) {
+  std::vector<DataArrayEntry> arrays;
+  data_arrays(reader_root, nullptr, "", arrays);
+  vtkXMLDataElement* appended = reader_root->LookupElementWithName("AppendedData");
+  const char* encoding = appended != nullptr ? appended->GetAttribute("encoding") : nullptr;
+  const bool appended_base64 =
+      appended != nullptr && (encoding == nullptr || std::strcmp(encoding, "raw") != 0);
+  const auto checked = [&](const DataArrayEntry& a) {
+    return a.format == "ascii" || a.format == "binary" || (a.format == "appended" && appended_base64);
+  };
+  if (std::none_of(arrays.begin(), arrays.end(), checked)) return;  // hexbite's own files: raw appended
+  // A parser of its own: the reader's has closed its file after reading the XML (a read through it threw
+  // "basic_ios::clear"). It finds the inline and appended data as the reader does; the compressor is set
+  // as the reader sets it, from the file's compressor attribute.
+  std::ifstream in(file, std::ios::binary);
+  vtkNew<vtkXMLDataParser> parser;
+  parser->SetStream(&in);
+  if (parser->Parse() == 0 || parser->GetRootElement() == nullptr) return;  // the reader says what is wrong
+  vtkXMLDataElement* root = parser->GetRootElement();
+  if (const char* compressor = root->GetAttribute("compressor")) {
+    vtkSmartPointer<vtkDataCompressor> c;
+    if (std::strcmp(compressor, "vtkZLibDataCompressor") == 0)
+      c = vtkSmartPointer<vtkZLibDataCompressor>::New();
+    if (std::strcmp(compressor, "vtkLZ4DataCompressor") == 0)
+      c = vtkSmartPointer<vtkLZ4DataCompressor>::New();
+    if (std::strcmp(compressor, "vtkLZMADataCompressor") == 0)
+      c = vtkSmartPointer<vtkLZMADataCompressor>::New();
+    if (c == nullptr) return;  // the reader names an unknown compressor
+    parser->SetCompressor(c);
+  }
+  arrays.clear();
+  data_arrays(root, nullptr, "", arrays);
+  constexpr unsigned long long kChunk = 1 << 20;
+  std::vector<double> buffer;  // kChunk words of up to 8 bytes
+  for (const DataArrayEntry& a : arrays) {
+    if (!checked(a)) continue;
+    const bool in_xml = a.format == "ascii" || a.format == "binary";
+    // VTK finds an array's data after the first '>' of its element, even one inside the Name.
+    if (in_xml && a.name.find('>') != std::string::npos)
+      throw InputError("cannot read '" + file + "': its " +
+                       (a.section == "CellData"    ? "cell array '"
+                        : a.section == "PointData" ? "point array '"
+                                                   : "array '") +
+                       a.name + "' is stored in the XML (format=\"" + a.format +
+                       "\") and its name holds a '>', which VTK's reader takes for the end of the element; "
+                       "rename the array where the file was made (or save the file with appended data)");
+    int word_type = 0;
+    if (a.values < 0 || a.element->GetWordTypeAttribute("type", word_type) == 0) continue;
+    if (buffer.empty()) buffer.resize(kChunk);
+    const unsigned long long expected = static_cast<unsigned long long>(a.values);
+    unsigned long long count = 0;
+    for (;;) {
+      const unsigned long long start = count == 0 ? 0 : count - 1;
+      const std::size_t want = static_cast<std::size_t>(std::min(kChunk, expected + 1 - start));
+      const std::size_t got =
+          in_xml
+              ? parser->ReadInlineData(a.element, a.format == "ascii", buffer.data(), start, want, word_type)
+              : parser->ReadAppendedData(a.offset, buffer.data(), start, want, word_type);
+      count = start + got;
+      if (got < want || count > expected) break;
+    }
+    if (count != expected)
+      throw damaged_array(
+          file, a.name,
+          count > expected
+              ? "holds more than the " + std::to_string(expected) + " values its piece's counts give"
+              : "holds " + std::to_string(count) + " values where its piece's counts give " +
+                    std::to_string(expected));
   }
 }
 
@@ -336,13 +436,16 @@ void update_xml_reader(vtkXMLReader* reader, const std::string& file) {
     }
     // VTK reads a file with an unnamed array as if it held no cells at all.
     if (!unnamed.empty())
-      throw InputError("cannot read '" + file + "': a data array in its " + unnamed +
-                       " has no Name attribute; the file is damaged, or its writer left the name out");
+      throw InputError(
+          "cannot read '" + file + "': a data array in its " + unnamed +
+          " has no name (its Name attribute is missing or empty); the file is damaged, or its writer "
+          "left the name out");
     if (root != nullptr) {
       check_piece_counts(root, file);
       // A file read from a string (with_point_data above) has its data in that string, not in the file;
       // its offsets are the file's own, so the file's bytes are checked all the same.
       check_appended_blocks(root, file);
+      check_array_lengths(root, file);
       disable_string_arrays(root, reader);
     }
     reader->Update();

@@ -1,12 +1,9 @@
-// Small pieces of self-contained HTML: escaped text and embedded pictures.
+// Small pieces of self-contained HTML: embedded pictures (escaped text: common/markup_escape.h).
 #pragma once
 
 #include <string>
 
 namespace hexbite {
-
-// `text` safe inside HTML elements and attribute values: & < > " ' as character references.
-std::string html_escape(const std::string& text);
 
 // `bytes` in base64 (RFC 4648, with padding), e.g. for a data: URI.
 std::string base64(const std::string& bytes);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common/markup_escape.h"
 #include "common/number_format.h"
 #include "mesher/vec3.h"
 #include "postprocess/html.h"
@@ -82,20 +83,21 @@ void what_was_run(std::ostringstream& out, const RunFigures& r, const ReportOpti
   const LevelFigures& l = r.coarse;
   out << "<h2>What was run</h2>\n";
   Table t(out);
-  t.row({text("scenario"), text(html_escape(r.scenario) + " (file " + html_escape(r.scenario_file) + ")")});
+  t.row(
+      {text("scenario"), text(markup_escape(r.scenario) + " (file " + markup_escape(r.scenario_file) + ")")});
   if (r.study)
     t.row({text("study"),
-           text("variant " + html_escape(r.study->variant) + " of study " + html_escape(r.study->name) +
-                " (file " + html_escape(r.study->file) + "): " +
+           text("variant " + markup_escape(r.study->variant) + " of study " + markup_escape(r.study->name) +
+                " (file " + markup_escape(r.study->file) + "): " +
                 (r.study->changes.empty() ? std::string("the scenario as it is")
-                                          : "the scenario with " + html_escape(r.study->changes)))});
+                                          : "the scenario with " + markup_escape(r.study->changes)))});
   t.row({text("hexbite"), text(r.hexbite_version.empty()
-                                   ? "report written by hexbite " + html_escape(o.hexbite_version) +
+                                   ? "report written by hexbite " + markup_escape(o.hexbite_version) +
                                          "; this results.json does not record the version that ran"
-                                   : "run with hexbite " + html_escape(r.hexbite_version) +
-                                         ", report written by hexbite " + html_escape(o.hexbite_version))});
-  t.row({text("mesh"), text("method " + html_escape(r.mesh_method) +
-                            (r.mesh_core.empty() ? "" : ", core " + html_escape(r.mesh_core)) + "; " +
+                                   : "run with hexbite " + markup_escape(r.hexbite_version) +
+                                         ", report written by hexbite " + markup_escape(o.hexbite_version))});
+  t.row({text("mesh"), text("method " + markup_escape(r.mesh_method) +
+                            (r.mesh_core.empty() ? "" : ", core " + markup_escape(r.mesh_core)) + "; " +
                             format_count(l.hexes) + " hexes, " + format_count(l.nodes) + " nodes")});
   t.row({text("finite elements"), text("Q" + std::to_string(r.degree) + ", " + format_count(l.dofs) +
                                        " degrees of freedom on the coarse mesh (level 0)")});
@@ -111,7 +113,7 @@ void what_was_run(std::ostringstream& out, const RunFigures& r, const ReportOpti
 void warnings_section(std::ostringstream& out, const std::vector<std::string>& warnings) {
   if (warnings.empty()) return;
   out << "<h2>Warnings</h2>\n<div class=\"warnings\"><ul>\n";
-  for (const std::string& w : warnings) out << "<li>" << html_escape(w) << "</li>\n";
+  for (const std::string& w : warnings) out << "<li>" << markup_escape(w) << "</li>\n";
   out << "</ul></div>\n";
 }
 
@@ -131,7 +133,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
     };
     row("bone (default)", *r.default_material, r.coarse.hexes - in_regions);
     for (const MaterialFigures& m : r.material_regions)
-      row("region " + html_escape(m.name), m, m.hexes.value_or(0));
+      row("region " + markup_escape(m.name), m, m.hexes.value_or(0));
   } else {
     out << "<p>This results.json records no materials (it was written by an older hexbite): see the "
            "scenario file.</p>\n";
@@ -144,7 +146,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
     for (const MuscleFigures& m : r.muscles) {
       const std::string activation = format_table_number(m.activation.value_or(0), 2, 0);
       const Vec3 unit = m.magnitude > 0 ? vec3::scale(m.force, 1.0 / m.magnitude) : m.force;
-      t.row({text(html_escape(m.name)), num(m.activation ? activation : "n/a"),
+      t.row({text(markup_escape(m.name)), num(m.activation ? activation : "n/a"),
              num(format_newtons(m.magnitude)), text(format_point(unit, 2)),
              num(format_count(std::lround(m.patch_area_mm2)))});
     }
@@ -163,12 +165,12 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
     } else if (s.fixed) {
       condition = "fixed";
       for (std::size_t i = 0; i < s.fixed->size(); ++i)
-        condition += (i == 0 ? " " : ", ") + html_escape((*s.fixed)[i]);
+        condition += (i == 0 ? " " : ", ") + markup_escape((*s.fixed)[i]);
       if (s.contact) condition += " (contact: pushes only)";
     }
     char radius[32];
     std::snprintf(radius, sizeof radius, "%g", s.radius_mm.value_or(0));
-    t.row({text(html_escape(s.name)), text(condition), text(s.center ? format_point(*s.center) : "n/a"),
+    t.row({text(markup_escape(s.name)), text(condition), text(s.center ? format_point(*s.center) : "n/a"),
            num(s.radius_mm ? radius : "n/a"), num(format_count(std::lround(s.patch_area_mm2)))});
   }
 }
@@ -201,7 +203,7 @@ void results_section(std::ostringstream& out, const RunFigures& r) {
   t.header({text("support"), text("bite"), num("F<sub>x</sub> (N)"), num("F<sub>y</sub> (N)"),
             num("F<sub>z</sub> (N)"), num("|F| (N)")});
   for (const ReactionFigures& s : l.reactions)
-    t.row({text(html_escape(s.name) + (s.released ? " (contact released: it would pull the bone)" : "")),
+    t.row({text(markup_escape(s.name) + (s.released ? " (contact released: it would pull the bone)" : "")),
            text(s.bite ? "yes" : "no"), num(format_newtons(s.force[0])), num(format_newtons(s.force[1])),
            num(format_newtons(s.force[2])), num(format_newtons(s.magnitude))});
 }
@@ -248,8 +250,8 @@ void validation_section(std::ostringstream& out, const RunFigures& r) {
     const std::size_t count =
         at.empty() ? 0 : 1 + static_cast<std::size_t>(std::count(at.begin(), at.end(), ','));
     if (count > 0 && count < r.levels.size())
-      differs +=
-          (differs.empty() ? "" : "; ") + html_escape(r.levels.front().reactions[i].name) + " at level " + at;
+      differs += (differs.empty() ? "" : "; ") + markup_escape(r.levels.front().reactions[i].name) +
+                 " at level " + at;
   }
   if (!differs.empty())
     out << "<p class=\"note\">Contacts released at some levels only (" << differs
@@ -306,14 +308,14 @@ void probes_section(std::ostringstream& out, const RunFigures& r) {
             num("von Mises (MPa)"), num("moved (mm)")});
   for (const ProbeFigures& p : r.coarse.probes) {
     if (!p.found) {
-      t.row({text(html_escape(p.name)), text(format_point(p.at)), text("not in the mesh"), num("n/a"),
+      t.row({text(markup_escape(p.name)), text(format_point(p.at)), text("not in the mesh"), num("n/a"),
              num("n/a"), num(format_mm(p.moved_mm))});
       continue;
     }
     char u[128];
     std::snprintf(u, sizeof u, "(%s, %s, %s)", format_mm(p.displacement[0]).c_str(),
                   format_mm(p.displacement[1]).c_str(), format_mm(p.displacement[2]).c_str());
-    t.row({text(html_escape(p.name)), text(format_point(p.at)), text(u),
+    t.row({text(markup_escape(p.name)), text(format_point(p.at)), text(u),
            num(format_mm(vec3::norm(p.displacement))), num(format_mpa(p.von_mises)),
            num(format_mm(p.moved_mm))});
   }
@@ -343,9 +345,9 @@ void pictures_section(std::ostringstream& out, const std::vector<ReportPicture>&
   out << "<p class=\"note\">The coarse level&rsquo;s solution on the outer surface of the mesh, node "
          "values (the corner stresses of the adjacent hexes averaged).</p>\n";
   for (const ReportPicture& p : pictures)
-    out << "<figure><img alt=\"" << html_escape(p.field + ", " + p.view + " view")
-        << "\" src=\"data:image/png;base64," << base64(p.png) << "\">\n<figcaption>" << html_escape(p.caption)
-        << "</figcaption></figure>\n";
+    out << "<figure><img alt=\"" << markup_escape(p.field + ", " + p.view + " view")
+        << "\" src=\"data:image/png;base64," << base64(p.png) << "\">\n<figcaption>"
+        << markup_escape(p.caption) << "</figcaption></figure>\n";
 }
 
 }  // namespace
@@ -406,7 +408,7 @@ std::vector<std::string> report_warnings(const RunFigures& r) {
 
 std::string report_html(const RunFigures& r, const std::vector<std::string>& warnings,
                         const std::vector<ReportPicture>& pictures, const ReportOptions& o) {
-  const std::string title = html_escape(o.title.empty() ? r.scenario : o.title);
+  const std::string title = markup_escape(o.title.empty() ? r.scenario : o.title);
   std::ostringstream out;
   out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << title
       << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n<h1>" << title

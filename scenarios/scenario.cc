@@ -432,7 +432,7 @@ Materials parse_materials(const Value& v) {
       const Map r(item, {"name", "sphere", "box", "E_MPa", "poisson"});
       MaterialRegion region;
       region.where = item.at;
-      region.name = to_string(r.require("name", "name: implant_site"));
+      region.name = to_name(r.require("name", "name: implant_site"));
       if (r.has("sphere") == r.has("box"))
         fail(item.at, item.path + " (" + quote(region.name) +
                           ") needs exactly one shape, 'sphere: {center, radius_mm}' or 'box: {min, max}'");
@@ -491,7 +491,7 @@ Muscle default_muscle(const std::string& name, const SourceLocation& where) {
 
 Muscle parse_muscle(const Value& item) {
   const Map map(item, {"name", "insertion", "radius_mm", "origin", "direction", "max_force_N", "activation"});
-  Muscle m = default_muscle(to_string(map.require("name", "name: right_superficial_masseter")), item.at);
+  Muscle m = default_muscle(to_name(map.require("name", "name: right_superficial_masseter")), item.at);
   if (auto x = map.find("insertion")) m.insertion = to_point(*x);
   if (auto x = map.find("radius_mm")) {
     m.radius_mm = patch_radius(*x, "the insertion patch radius in mm, e.g. 10");
@@ -584,7 +584,7 @@ Support parse_support(const Value& item) {
   Support s;
   s.where = item.at;
   const Value& name = map.require("name", "name: right_condyle");
-  s.name = to_string(name);
+  s.name = to_name(name);
   s.name_at = name.at;
   s.at = to_point(map.require("at", "at: right_condyle_tmj_point"));
   s.radius_mm =
@@ -787,7 +787,7 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
                " is not known to this hexbite, which reads format_version 1; update hexbite or the file");
     s.format_version = 1;
   }
-  s.name = to_string(root.require("name", "name: lateral_bite"));
+  s.name = to_name(root.require("name", "name: lateral_bite"));
   if (auto x = root.find("description"))
     s.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x, kTextHint);
   s.geometry = parse_geometry(ctx, root.require("geometry", "geometry: {mandible: {variant: dentate}}"));
@@ -806,7 +806,7 @@ Scenario parse_scenario_tree(const YAML::Node& root_node, const Source& ctx) {
     for (const Value& item : to_list(*x)) {
       const Map p(item, {"name", "at"});
       const Value& name = p.require("name", "name: chin");
-      s.probes.push_back({to_string(name, "write a name such as chin"),
+      s.probes.push_back({to_name(name, "write a name such as chin"),
                           to_point(p.require("at", "at: incisal_point")), item.at, name.at});
     }
   check_poisson_for_degree(s);

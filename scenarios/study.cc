@@ -181,7 +181,7 @@ Study load_study(const std::string& path) {
   Study study;
   study.path = path;
   study.name =
-      to_string(map.require("name", "name: atrophy what-if"), "write a name such as 'atrophy what-if'");
+      to_name(map.require("name", "name: atrophy what-if"), "write a name such as 'atrophy what-if'");
   if (auto x = map.find("description"))
     study.description = x->node.IsScalar() && x->node.Scalar().empty() ? "" : to_string(*x, kTextHint);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -53,6 +54,19 @@ std::string to_string(const Value& v, const std::string& hint) {
   if (v.node.IsScalar() && v.node.Scalar().empty()) fail(v.at, v.path + " is empty; " + hint);
   if (!v.node.IsScalar()) fail(v.at, v.path + " must be text, found " + describe(v.node) + "; " + hint);
   return v.node.Scalar();
+}
+
+std::string to_name(const Value& v, const std::string& hint) {
+  const std::string name = to_string(v, hint);
+  for (const char c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char code[8];
+      std::snprintf(code, sizeof code, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      fail(v.at, v.path + " holds a control character (" + code + (c == '\n' ? ", a line break" : "") +
+                     "); a name is one line of printable text: remove it (in YAML, '\\n' in double "
+                     "quotes is a line break)");
+    }
+  return name;
 }
 
 std::vector<Value> to_list(const Value& v) {

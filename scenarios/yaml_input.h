@@ -68,6 +68,10 @@ inline const std::string kTextHint =
 
 // Non-empty text; `hint` says what to write instead of a list, a mapping or nothing.
 std::string to_string(const Value& v, const std::string& hint = "write a word such as left_condyle");
+// to_string() for a name (of the scenario, a region, muscle, support, probe or study): names go into comment
+// and heading lines of the files written (model.inp, reports), so a control character (a newline, a tab)
+// is refused at its line: "incisal\n*HEADING" made the rest of the name a CalculiX keyword line.
+std::string to_name(const Value& v, const std::string& hint = "write a word such as left_condyle");
 std::vector<Value> to_list(const Value& v);  // a list (null reads as an empty one)
 
 // A mapping whose keys are checked against the valid ones on construction (unknown and repeated keys are

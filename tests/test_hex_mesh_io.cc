@@ -84,6 +84,26 @@ TEST(HexMeshIo, VtuRoundTripWithArrays) {
   EXPECT_EQ(files, 2);
 }
 
+// Names holding XML's special characters are escaped in the file: reorder wrote Name="E & nu" as it was,
+// and no XML reader (hexbite's included) accepted the file it made.
+TEST(HexMeshIo, VtuArrayNamesWithXmlCharactersReadBack) {
+  const HexMesh mesh = make_block_mesh(1, 1, 1);
+  const std::string name = "E & nu <\"x\"> 'y'";
+  const std::string dir = temp_dir();
+  write_vtu(dir + "/a.vtu", mesh, {{name, 1, {7.0}}}, {{name, 1, std::vector<double>(8, 2.0)}});
+  std::vector<MeshArray> cells, points;
+  read_vtu(dir + "/a.vtu", &cells, &points);
+  ASSERT_NE(find_array(cells, name), nullptr);
+  EXPECT_EQ(find_array(cells, name)->values, std::vector<double>{7.0});
+  ASSERT_NE(find_array(points, name), nullptr);
+  // And through the command that found it.
+  const auto r = run_hexbite({"reorder", dir + "/a.vtu", "-o", dir + "/b.vtu", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  cells.clear();
+  read_vtu(dir + "/b.vtu", &cells);
+  EXPECT_NE(find_array(cells, name), nullptr);
+}
+
 TEST(HexMeshIo, VtuRejectsBadArrays) {
   const HexMesh mesh = make_block_mesh(1, 1, 1);
   const std::string path = temp_dir() + "/bad.vtu";
@@ -171,16 +191,127 @@ TEST(HexMeshIo, VtuReaderErrors) {
   write_file(dir + "/short.vtu", with_array("<DataArray type=\"Float64\" Name=\"region\" format=\"ascii\">"
                                             "</DataArray>"));
   msg = test::message_of<InputError>([&] { read_vtu(dir + "/short.vtu"); });
-  EXPECT_NE(msg.find("damaged or truncated"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("cell data array \"region\""), std::string::npos) << msg;
+  EXPECT_NE(msg.find("the data of its array 'region' holds 0 values where its piece's counts give 1"),
+            std::string::npos)
+      << msg;
   write_file(dir + "/cells_only.vtu",
              with_array("<DataArray type=\"Float64\" Name=\"region\" format=\"ascii\">7</DataArray>"));
   EXPECT_EQ(read_vtu(dir + "/cells_only.vtu").hexes.size(), 1u);
   // An array without a name: VTK read no cells at all ("holds no hexahedra").
   write_file(dir + "/unnamed.vtu", with_array("<DataArray type=\"Float64\" format=\"ascii\">7</DataArray>"));
   msg = test::message_of<InputError>([&] { read_vtu(dir + "/unnamed.vtu"); });
-  EXPECT_NE(msg.find("a data array in its <CellData> of piece 0 has no Name attribute"), std::string::npos)
+  EXPECT_NE(
+      msg.find(
+          "a data array in its <CellData> of piece 0 has no name (its Name attribute is missing or empty)"),
+      std::string::npos)
       << msg;
+}
+
+// VTK reads as many values as a piece's counts give and ignores the rest: a 2-hex file whose NumberOfCells
+// said 1 read as 1 hex (exit 0) in every encoding but raw appended data. Now each array's length is checked.
+TEST(HexMeshIo, VtuArraysLongerThanTheCountsAreRefused) {
+  const std::string dir = temp_dir();
+  const std::string two = ascii_vtu(2, "12 12", "0 1 2 3 4 5 6 7 1 8 9 2 5 10 11 6", "8 16",
+                                    "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1 "
+                                    "2 0 0 2 1 0 2 0 1 2 1 1",
+                                    12);
+  write_file(dir + "/two.vtu", two);
+  EXPECT_EQ(read_vtu(dir + "/two.vtu").hexes.size(), 2u);
+  const auto one_cell = [](std::string text) {
+    return text.replace(text.find("NumberOfCells=\"2\""), 17, "NumberOfCells=\"1\"");
+  };
+  write_file(dir + "/ascii.vtu", one_cell(two));
+  std::string msg = test::message_of<InputError>([&] { read_vtu(dir + "/ascii.vtu"); });
+  EXPECT_NE(msg.find("ascii.vtu': the data of its array 'offsets' holds more than the 1 values its piece's "
+                     "counts give; the file is damaged"),
+            std::string::npos)
+      << msg;
+  // The same through VTK's writer, inline base64 and appended base64, compressed or not.
+  vtkNew<vtkPoints> points;
+  for (const Vec3& p : make_block_mesh(2, 1, 1).vertices) points->InsertNextPoint(p.data());
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  for (const std::array<int, 8>& hex : make_block_mesh(2, 1, 1).hexes) {
+    const vtkIdType ids[8] = {hex[0], hex[1], hex[2], hex[3], hex[4], hex[5], hex[6], hex[7]};
+    grid->InsertNextCell(VTK_HEXAHEDRON, 8, ids);
+  }
+  for (const bool appended : {false, true})
+    for (const bool compressed : {false, true}) {
+      vtkNew<vtkXMLUnstructuredGridWriter> writer;
+      writer->SetInputData(grid);
+      writer->WriteToOutputStringOn();
+      if (appended) {
+        writer->SetDataModeToAppended();
+        writer->EncodeAppendedDataOn();
+      } else {
+        writer->SetDataModeToBinary();
+      }
+      if (!compressed) writer->SetCompressorTypeToNone();
+      ASSERT_EQ(writer->Write(), 1);
+      const std::string name = std::string(appended ? "appended" : "inline") + (compressed ? "_z" : "");
+      write_file(dir + "/" + name + ".vtu", writer->GetOutputString());
+      EXPECT_EQ(read_vtu(dir + "/" + name + ".vtu").hexes.size(), 2u) << name;
+      write_file(dir + "/" + name + "_1.vtu", one_cell(writer->GetOutputString()));
+      msg = test::message_of<InputError>([&] { read_vtu(dir + "/" + name + "_1.vtu"); });
+      EXPECT_NE(msg.find("holds more than the 1 values its piece's counts give"), std::string::npos)
+          << name << ": " << msg;
+    }
+}
+
+// '>' is legal in an XML attribute, but VTK's reader takes it for the end of an inline array's element and
+// said "Cannot read cell data array "E>nu" from PointData". The message now names the name as the cause;
+// an empty Name is called empty.
+TEST(HexMeshIo, VtuArrayNamesVtkCannotReadAreNamed) {
+  const std::string dir = temp_dir();
+  std::string text = ascii_vtu(1, "12", "0 1 2 3 4 5 6 7", "8", kCubePoints, 8);
+  const auto with_cell_array = [&](const std::string& name) {
+    std::string t = text;
+    return t.insert(t.find("<Points>"),
+                    "<PointData></PointData><CellData><DataArray type=\"Float64\" Name=\"" + name +
+                        "\" format=\"ascii\">7</DataArray></CellData>\n");
+  };
+  write_file(dir + "/gt.vtu", with_cell_array("E>nu"));
+  std::string msg = test::message_of<InputError>([&] { read_vtu(dir + "/gt.vtu"); });
+  EXPECT_NE(msg.find("its cell array 'E>nu' is stored in the XML (format=\"ascii\") and its name holds a "
+                     "'>'"),
+            std::string::npos)
+      << msg;
+  write_file(dir + "/empty_name.vtu", with_cell_array(""));
+  msg = test::message_of<InputError>([&] { read_vtu(dir + "/empty_name.vtu"); });
+  EXPECT_NE(msg.find("has no name (its Name attribute is missing or empty)"), std::string::npos) << msg;
+  // Written by hexbite, such a name reads back (it is escaped, and the data is appended).
+  write_vtu(dir + "/ok.vtu", make_block_mesh(1, 1, 1), {{"E>nu", 1, {7.0}}});
+  std::vector<MeshArray> cells;
+  read_vtu(dir + "/ok.vtu", &cells);
+  EXPECT_NE(find_array(cells, "E>nu"), nullptr);
+}
+
+// A .vtu with its boundary quads, or of voxels, was refused ("cell 1 is a vtkQuad"), where the .msh reader
+// skips boundary quads: surface cells are skipped (and their values of cell arrays), a voxel is read as the
+// hexahedron it is, and another volume cell is refused with what to do.
+TEST(HexMeshIo, VtuSurfaceCellsAreSkippedAndVoxelsRead) {
+  const std::string dir = temp_dir();
+  write_file(dir + "/voxel.vtu", ascii_vtu(1, "11", "0 1 3 2 4 5 7 6", "8", kCubePoints, 8));
+  const HexMesh voxel = read_vtu(dir + "/voxel.vtu");
+  ASSERT_EQ(voxel.hexes.size(), 1u);
+  EXPECT_EQ(voxel.hexes[0], (std::array<int, 8>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_GT(compute_hex_quality(voxel).scaled_jacobian[0], 0.99);
+
+  std::string text = ascii_vtu(3, "9 12 5", "0 1 2 3 0 1 2 3 4 5 6 7 4 5 6", "4 12 15", kCubePoints, 8);
+  text.insert(text.find("<Points>"),
+              "<PointData></PointData><CellData><DataArray type=\"Int32\" "
+              "Name=\"region\" format=\"ascii\">5 9 6</DataArray></CellData>\n");
+  write_file(dir + "/with_quads.vtu", text);
+  std::vector<MeshArray> cells;
+  const HexMesh mesh = read_vtu(dir + "/with_quads.vtu", &cells);
+  ASSERT_EQ(mesh.hexes.size(), 1u);
+  ASSERT_NE(find_array(cells, "region"), nullptr);
+  EXPECT_EQ(find_array(cells, "region")->values, std::vector<double>{9});
+
+  write_file(dir + "/wedge.vtu", ascii_vtu(1, "13", "0 1 2 4 5 6", "6", kCubePoints, 8));
+  const std::string msg = test::message_of<InputError>([&] { read_vtu(dir + "/wedge.vtu"); });
+  EXPECT_NE(msg.find("cell 0 is a vtkWedge (VTK cell type 13); only hexahedra"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Mesh.SubdivisionAlgorithm = 2"), std::string::npos) << msg;
 }
 
 // Before, a file without hexahedra read as an empty mesh (quality printed n/a, refine wrote an empty mesh,
@@ -425,6 +556,9 @@ TEST(HexMeshIo, InpExport) {
 
   EXPECT_THROW(write_inp(path, mesh, {{"1bad", {0}}}), std::invalid_argument);
   EXPECT_THROW(write_inp(path, mesh, {{"nall", {0}}}), std::invalid_argument);
+  // CalculiX printed an 80-character set name blank in model.dat ("total force ... for set  and time").
+  EXPECT_NO_THROW(write_inp(path, mesh, {{std::string(79, 'A'), {0}}}));
+  EXPECT_THROW(write_inp(path, mesh, {{std::string(80, 'A'), {0}}}), std::invalid_argument);
   EXPECT_THROW(write_inp(path, mesh, {}, {{"E", {12}}}), std::invalid_argument);
 }
 
@@ -529,6 +663,41 @@ TEST(HexMeshIo, MshVersion22WithLowerDimensionalElements) {
   write_file(dir + "/junk.msh", "hello\n");
   EXPECT_NE(test::message_of<InputError>([&] { read_msh(dir + "/junk.msh"); }).find("not a Gmsh"),
             std::string::npos);
+}
+
+// Gmsh physical groups were dropped without a word by reorder and refine (a .vtu input's arrays get a
+// warning): they are read, with their names, and named in a warning.
+TEST(HexMeshIo, MshPhysicalGroupsAreNamedWhenNotCarriedOver) {
+  const std::string dir = temp_dir();
+  write_file(
+      dir + "/v22.msh",
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n2 5 \"floor\"\n3 1 \"cortical bone\"\n"
+      "$EndPhysicalNames\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n"
+      "8 0 1 1\n$EndNodes\n$Elements\n2\n1 3 2 5 1 1 4 3 2\n2 5 2 1 1 1 2 3 4 5 6 7 8\n$EndElements\n");
+  GmshTags tags;
+  read_msh(dir + "/v22.msh", &tags);
+  EXPECT_EQ(tags.physical_groups, (std::vector<std::string>{"physical group 'floor' (2-D, tag 5)",
+                                                            "physical group 'cortical bone' (3-D, tag 1)"}));
+  write_file(dir + "/v41.msh",
+             "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 1 7 0\n$EndEntities\n"
+             "$Nodes\n1 8 1 8\n3 1 0 8\n1\n2\n3\n4\n5\n6\n7\n8\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n"
+             "1 1 1\n0 1 1\n$EndNodes\n$Elements\n1 1 1 1\n3 1 5 1\n1 1 2 3 4 5 6 7 8\n$EndElements\n");
+  read_msh(dir + "/v41.msh", &tags);
+  EXPECT_EQ(tags.physical_groups, std::vector<std::string>{"physical group 7 (3-D)"});
+  // hexbite's own .msh has none.
+  write_msh(dir + "/own.msh", make_block_mesh(1, 1, 1));
+  read_msh(dir + "/own.msh", &tags);
+  EXPECT_TRUE(tags.physical_groups.empty());
+
+  for (const char* command : {"reorder", "refine"}) {
+    const auto r = run_hexbite({command, dir + "/v22.msh", "-o", dir + "/out.msh", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: not carried over to " + dir +
+                         "/out.msh: physical group 'floor' (2-D, tag 5), "
+                         "physical group 'cortical bone' (3-D, tag 1)"),
+              std::string::npos)
+        << command << ": " << r.err;
+  }
 }
 
 // Two hexes that touch but do not share their corner nodes (two Gmsh volumes meshed without Coherence Mesh)

@@ -361,6 +361,19 @@ TEST(ScenarioErrors, UnknownKeySuggestsTheClosest) {
                   "did you mean 'dentate'?");
 }
 
+// A name is one line of printable text: "incisal\n*HEADING" split model.inp's comment line, and the rest of
+// the name became a CalculiX keyword line.
+TEST(ScenarioErrors, NamesWithControlCharactersAreRefusedAtTheirLine) {
+  EXPECT_ERROR_AT(error_of(replace(kValid, "name: t", "name: \"incisal\\n*HEADING\\nbite\"")), 1,
+                  "name holds a control character (0x0A, a line break)");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "name: right_superficial_masseter", "name: \"right\\tmasseter\"")),
+                  5, "muscles[0].name holds a control character (0x09)");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "{name: nut,", "{name: \"n\\x01ut\",")), 8,
+                  "supports[0].name holds a control character (0x01)");
+  EXPECT_ERROR_AT(error_of(kValid + "probes:\n  - {name: \"chin\\r\", at: incisal_point}\n"), 12,
+                  "probes[0].name holds a control character (0x0D)");
+}
+
 // mesh.fit_volume (the boundary nodes moved off the surface until the volume matches) is read for both
 // methods, and is false by default.
 TEST(Scenario, FitVolumeIsReadForBothMethods) {
