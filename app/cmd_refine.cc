@@ -4,7 +4,8 @@
 // Splits every hex into 8 (every boundary quad into 4), puts the new boundary nodes onto the surface when one
 // is given and re-optimizes where that made the quality worse; prints the quality before and after each step
 // and the timings. The coarse nodes keep their numbers and positions, so coarse and fine results can be
-// compared node by node. An input mesh with inverted hexes is refused up front (exit 2, naming them with
+// compared node by node; a .vtu output gives each child hex its parent's values of the input's own cell
+// arrays. An input mesh with inverted hexes is refused up front (exit 2, naming them with
 // their centroids); a refined mesh with inverted hexes is a failed run (exit 1, naming them likewise).
 // Neither is written.
 #include <CLI/CLI.hpp>
@@ -14,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/carried_arrays.h"
 #include "app/commands.h"
 #include "app/mesh_inputs.h"
 #include "app/option_checks.h"
@@ -197,10 +199,23 @@ void require_mesh_on_surface(const HexMeshInput& input, const SurfaceProjector& 
   throw InputError(text.str());
 }
 
+// The input's cell arrays for the refined mesh: the children of hex h are hexes h << shift to
+// ((h + 1) << shift) - 1 (refine_to_surface), and each gets h's values.
+std::vector<MeshArray> arrays_of_children(const std::vector<MeshArray>& arrays, std::size_t hexes,
+                                          int shift) {
+  std::vector<int> parent_of;
+  for (std::size_t h = 0; h < (hexes << shift); ++h) parent_of.push_back(static_cast<int>(h >> shift));
+  std::vector<MeshArray> out;
+  for (const MeshArray& a : arrays) out.push_back(array_tuples(a, parent_of));
+  return out;
+}
+
 void run_refine(const RefineCliOptions& o) {
   if (o.fit_volume && o.surface.empty())
     throw InputError("--fit-volume fits the refined boundary to the volume of the --surface: give --surface");
-  const HexMeshInput input = load_hex_mesh_input(o.mesh);
+  std::vector<MeshArray> cell_arrays, point_arrays;
+  std::vector<std::string> not_read;
+  const HexMeshInput input = load_hex_mesh_input(o.mesh, &cell_arrays, &point_arrays, &not_read);
   const HexMesh& coarse = input.mesh;
   const long long refined = static_cast<long long>(coarse.hexes.size()) << (3 * o.levels);
   if (refined > kMaxRefinedHexes)
@@ -222,8 +237,12 @@ void run_refine(const RefineCliOptions& o) {
   RefineReport report;
   const HexMesh fine = refine_to_surface(coarse, projector.get(), options, &report);
   const bool valid = report.after.inverted == 0;
-  if (valid) write_hex_mesh(o.output, fine);
-  if (valid) input.warn_physical_groups_not_carried(o.mesh, o.output, "refine");
+  if (valid) {
+    const CellArrays cells = split_cell_arrays(coarse, cell_arrays);
+    write_hex_mesh(o.output, fine, arrays_of_children(cells.own, coarse.hexes.size(), 3 * o.levels));
+    warn_arrays_not_carried(o.mesh, o.output, "refine", cells, point_arrays, false, not_read);
+    input.warn_physical_groups_not_carried(o.mesh, o.output, "refine");
+  }
 
   if (o.json)
     std::cout << json_text(report_json(o, report, valid)) << '\n';

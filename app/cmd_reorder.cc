@@ -5,9 +5,7 @@
 // Cuthill-McKee. Prints the bandwidth and profile of the nodal adjacency before and after. The geometry is
 // unchanged; the input's own cell and point arrays are carried over in the new order.
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -15,6 +13,7 @@
 #include <optional>
 #include <sstream>
 
+#include "app/carried_arrays.h"
 #include "app/commands.h"
 #include "app/mesh_inputs.h"
 #include "app/option_checks.h"
@@ -57,84 +56,8 @@ Vec3 parse_point(const std::string& text) {
 // The arrays in the new order.
 std::vector<MeshArray> permute_arrays(const std::vector<MeshArray>& arrays, const std::vector<int>& order) {
   std::vector<MeshArray> out;
-  for (const MeshArray& a : arrays) {
-    MeshArray p = a;
-    p.values.clear();
-    p.bits64.clear();
-    for (int i : order)
-      for (int c = 0; c < a.components; ++c) {
-        const std::size_t k = static_cast<std::size_t>(i) * a.components + c;
-        p.values.push_back(a.values[k]);
-        if (!a.bits64.empty()) p.bits64.push_back(a.bits64[k]);
-      }
-    out.push_back(std::move(p));
-  }
+  for (const MeshArray& a : arrays) out.push_back(array_tuples(a, order));
   return out;
-}
-
-// Whether `a` holds what write_vtu writes as its quality array `values`: Float64, one value per hex, equal
-// up to the last bits (inf for an inverted hex; NaN where the measure is NaN).
-bool is_hexbite_quality(const MeshArray& a, const std::vector<double>& values) {
-  if (a.vtk_type != MeshArray().vtk_type || a.components != 1 || a.values.size() != values.size())
-    return false;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const double x = a.values[i], y = values[i];
-    const bool close = std::isfinite(y) && std::abs(x - y) <= 1e-12 * std::abs(y);
-    if (!(x == y || close || (std::isnan(x) && std::isnan(y)))) return false;
-  }
-  return true;
-}
-
-// The input's cell arrays split by their names: `own` the user's; `clashing` those named like a quality
-// array of write_vtu's but holding other values (a user's 'condition'), which the output's quality array of
-// that name replaces. Quality arrays that hexbite wrote are in neither: the writer recomputes them.
-struct CellArrays {
-  std::vector<MeshArray> own;
-  std::vector<std::string> clashing;
-};
-
-CellArrays split_cell_arrays(const HexMesh& mesh, const std::vector<MeshArray>& arrays) {
-  std::optional<HexQualityField> quality;  // computed when an array needs it
-  CellArrays out;
-  for (const MeshArray& a : arrays) {
-    const auto named = std::find(std::begin(kVtuQualityArrays), std::end(kVtuQualityArrays), a.name);
-    if (named == std::end(kVtuQualityArrays)) {
-      out.own.push_back(a);
-      continue;
-    }
-    if (!quality) quality = compute_hex_quality(mesh);
-    if (!is_hexbite_quality(a, vtu_quality_array(*quality, named - std::begin(kVtuQualityArrays))))
-      out.clashing.push_back(a.name);
-  }
-  return out;
-}
-
-// Warnings for what the output leaves out of the input. A .vtu carries the numeric arrays, except a user's
-// array under a quality array's name; .msh and .inp files carry no arrays at all.
-void warn_arrays_not_carried(const ReorderOptions& o, const CellArrays& cells,
-                             const std::vector<MeshArray>& point_arrays,
-                             const std::vector<std::string>& not_read) {
-  const bool vtu = lower_extension(o.output) == ".vtu";
-  for (std::size_t i = 0; vtu && i < cells.clashing.size(); ++i) {
-    const std::string& name = cells.clashing[i];
-    std::cerr << "hexbite: warning: cell array '" << name << "' of " << o.mesh
-              << " is not hexbite's quality array of that name (its values differ): " << o.output
-              << " holds hexbite's '" << name << "' (Float64) in its place; rename the array in " << o.mesh
-              << " to keep it.\n";
-  }
-  std::vector<std::string> lost;
-  if (!vtu) {
-    for (const MeshArray& a : cells.own) lost.push_back("cell array '" + a.name + "'");
-    for (const std::string& name : cells.clashing) lost.push_back("cell array '" + name + "'");
-    for (const MeshArray& a : point_arrays) lost.push_back("point array '" + a.name + "'");
-  }
-  lost.insert(lost.end(), not_read.begin(), not_read.end());
-  if (lost.empty()) return;
-  std::string list;
-  for (const std::string& item : lost) list += (list.empty() ? "" : ", ") + item;
-  std::cerr << "hexbite: warning: not carried over to " << o.output << ": " << list
-            << (vtu ? " (reorder carries the numeric cell and point arrays only).\n"
-                    : " (only a .vtu output carries arrays).\n");
 }
 
 void run_reorder(const ReorderOptions& o) {
@@ -188,7 +111,7 @@ void run_reorder(const ReorderOptions& o) {
   const CellArrays cells = split_cell_arrays(mesh, cell_arrays);
   write_hex_mesh(o.output, r.mesh, permute_arrays(cells.own, r.hex_order),
                  permute_arrays(point_arrays, r.node_order));
-  warn_arrays_not_carried(o, cells, point_arrays, not_read);
+  warn_arrays_not_carried(o.mesh, o.output, "reorder", cells, point_arrays, true, not_read);
   input.warn_physical_groups_not_carried(o.mesh, o.output, "reorder");
 
   if (o.json) {

@@ -265,6 +265,19 @@ void write_vtu(const std::string& path, const HexMesh& mesh, const std::vector<M
   write_file_atomically(path, writer->GetOutputString());
 }
 
+MeshArray array_tuples(const MeshArray& a, const std::vector<int>& tuples) {
+  const std::size_t n = static_cast<std::size_t>(a.components);
+  MeshArray out{a.name, a.components, {}, a.vtk_type, {}};
+  out.values.reserve(tuples.size() * n);
+  for (const int t : tuples) {
+    const std::size_t k = static_cast<std::size_t>(t) * n;
+    out.values.insert(out.values.end(), a.values.begin() + k, a.values.begin() + k + n);
+    if (!a.bits64.empty())
+      out.bits64.insert(out.bits64.end(), a.bits64.begin() + k, a.bits64.begin() + k + n);
+  }
+  return out;
+}
+
 HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
                  std::vector<MeshArray>* point_arrays, std::vector<std::string>* not_read) {
   check_readable(path, "hex mesh");
@@ -301,7 +314,7 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
   // Surface, line and point cells are skipped, as read_msh skips Gmsh's lower-dimensional elements (a mesh
   // exported with its boundary quads); a vtkVoxel is a hexahedron whose nodes 2, 3 and 6, 7 come in the
   // other order. `kept` lists the file's cells that became hexes, for the cell arrays.
-  std::vector<vtkIdType> kept;
+  std::vector<int> kept;
   for (vtkIdType c = 0; c < num_cells; ++c) {
     const int type = grid->GetCellType(c);
     if (type != VTK_HEXAHEDRON && type != VTK_VOXEL) {
@@ -333,24 +346,13 @@ HexMesh read_vtu(const std::string& path, std::vector<MeshArray>* cell_arrays,
       std::swap(hex[6], hex[7]);
     }
     mesh.hexes.push_back(hex);
-    kept.push_back(c);
+    kept.push_back(static_cast<int>(c));
   }
   check_mesh(mesh, where);
   if (cell_arrays != nullptr) {
     *cell_arrays = arrays_of(grid->GetCellData());
     if (kept.size() != static_cast<std::size_t>(num_cells))
-      for (MeshArray& a : *cell_arrays) {  // the values of the hexes only
-        const std::size_t n = static_cast<std::size_t>(a.components);
-        MeshArray hexes_only{a.name, a.components, {}, a.vtk_type, {}};
-        for (const vtkIdType c : kept) {
-          hexes_only.values.insert(hexes_only.values.end(), a.values.begin() + c * n,
-                                   a.values.begin() + (c + 1) * n);
-          if (!a.bits64.empty())
-            hexes_only.bits64.insert(hexes_only.bits64.end(), a.bits64.begin() + c * n,
-                                     a.bits64.begin() + (c + 1) * n);
-        }
-        a = std::move(hexes_only);
-      }
+      for (MeshArray& a : *cell_arrays) a = array_tuples(a, kept);  // the values of the hexes only
   }
   if (point_arrays != nullptr) *point_arrays = arrays_of(grid->GetPointData());
   if (not_read != nullptr) {

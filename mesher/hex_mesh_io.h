@@ -35,6 +35,9 @@ struct MeshArray {
   std::vector<std::uint64_t> bits64;
 };
 
+// The array whose tuple i is `a`'s tuple tuples[i] (bits64 too): a subset, a new order or repeats.
+MeshArray array_tuples(const MeshArray& a, const std::vector<int>& tuples);
+
 // A named set of 0-based node or element indices, for solver input files.
 struct IndexSet {
   std::string name;

@@ -1,5 +1,6 @@
 // Uniform 8-way refinement (mesher/hex_refine.h) and the `hexbite refine` command.
 #include <gtest/gtest.h>
+#include <vtkType.h>
 
 #include <algorithm>
 #include <cmath>
@@ -301,6 +302,56 @@ TEST_F(BallRefine, CommandRefusesASurfaceTheMeshDoesNotLieOn) {
       std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir + "/fine.msh"));
+}
+
+// A material id (a cell array) of the input was dropped without a word: refine wrote only its quality
+// arrays, and refinement.md said so. Each child hex now carries its parent's values, with the array's type;
+// point arrays (no value at the new nodes) are named in a warning, and a .msh output names both.
+TEST(HexRefineCommand, CellArraysGoToTheChildrenAndPointArraysAreNamed) {
+  const std::string dir = temp_dir();
+  const HexMesh coarse = block(2, 2, 1);
+  MeshArray material{"material", 1, {}, VTK_INT}, pair{"pair", 2, {}, VTK_DOUBLE};
+  for (std::size_t h = 0; h < coarse.hexes.size(); ++h) {
+    material.values.push_back(double(10 + h));
+    pair.values.insert(pair.values.end(), {double(h), -double(h)});
+  }
+  MeshArray temperature{"temperature", 1, std::vector<double>(coarse.vertices.size(), 37.0), VTK_DOUBLE};
+  write_vtu(dir + "/in.vtu", coarse, {material, pair}, {temperature});
+  const auto r = run_hexbite({"refine", dir + "/in.vtu", "--levels", "2", "-o", dir + "/fine.vtu", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("hexbite: warning: not carried over to " + dir +
+                       "/fine.vtu: point array 'temperature' (refine carries the numeric cell arrays only, "
+                       "each child hex with its parent's values: the new nodes have no values)."),
+            std::string::npos)
+      << r.err;
+  std::vector<MeshArray> cells, points;
+  const HexMesh fine = read_vtu(dir + "/fine.vtu", &cells, &points);
+  ASSERT_EQ(fine.hexes.size(), 64 * coarse.hexes.size());
+  EXPECT_TRUE(points.empty());
+  ASSERT_EQ(cells.size(), 6u);  // the four quality arrays, then the input's two
+  EXPECT_EQ(cells[4].name, "material");
+  EXPECT_EQ(cells[4].vtk_type, VTK_INT);
+  EXPECT_EQ(cells[5].name, "pair");
+  ASSERT_EQ(cells[4].values.size(), fine.hexes.size());
+  ASSERT_EQ(cells[5].values.size(), 2 * fine.hexes.size());
+  for (std::size_t h = 0; h < fine.hexes.size(); ++h) {
+    const std::size_t parent = h / 64;  // fine hex 8 h + c is the child of h, at each level
+    EXPECT_EQ(cells[4].values[h], double(10 + parent)) << h;
+    EXPECT_EQ(cells[5].values[2 * h], double(parent)) << h;
+    EXPECT_EQ(cells[5].values[2 * h + 1], -double(parent)) << h;
+  }
+  const auto msh = run_hexbite({"refine", dir + "/in.vtu", "-o", dir + "/fine.msh", "-q"});
+  ASSERT_EQ(msh.exit_code, 0) << msh.err;
+  EXPECT_NE(msh.err.find("not carried over to " + dir +
+                         "/fine.msh: cell array 'material', cell array 'pair', point array 'temperature' "
+                         "(only a .vtu output carries arrays)."),
+            std::string::npos)
+      << msh.err;
+  // A mesh that hexbite wrote (its quality arrays only) refines without a warning.
+  write_vtu(dir + "/own.vtu", coarse);
+  const auto own = run_hexbite({"refine", dir + "/own.vtu", "-o", dir + "/own_fine.vtu", "-q"});
+  ASSERT_EQ(own.exit_code, 0) << own.err;
+  EXPECT_EQ(own.err, "");
 }
 
 TEST(HexRefineCommand, BadInput) {
