@@ -796,6 +796,46 @@ void check_held_without_released(const Scenario& s, const LevelResult& r, const 
   }
 }
 
+// Address space a direct solve needs besides its matrix and factors: OpenBLAS's work buffer of 128 MB per
+// thread, which this OpenBLAS, when it cannot allocate it, retries forever (measured on the shipped
+// scenario's level 0 under ulimit -v: the process maps about 1.0 GB before the solve; at 1.1 GB it hung
+// inside MUMPS, at 1.2 GB it solved, at 1.0 GB MUMPS itself failed).
+constexpr double kDirectSolverHeadroom = 0.5e9;
+
+// solve_elasticity(p) on `dofs` degrees of freedom. The direct solver needs address space that an
+// address-space limit (ulimit -v) may not leave: when solver.linear_solver is auto, it chose the direct
+// solver for a small problem, and CG with AMG, which gives the same answer with far less memory, solves
+// instead (too little room before the solve, or MUMPS failing in it: under ulimit -v 1.0 GB it did); the
+// run's CG iterations then show it. A scenario that asked for the direct solver is refused before the solve.
+ElasticitySolution solve_or_fall_back(const Scenario& s, ElasticityProblem& p, int level, long long dofs) {
+  const bool automatic = s.solver.linear_solver == LinearSolverChoice::kAuto;
+  const std::string at_level =
+      "level " + std::to_string(level) + " (" + std::to_string(dofs) + " degrees of freedom): ";
+  if (p.solver.linear_solver == LinearSolver::kDirect) {
+    const MemoryLimit memory = machine_memory();
+    const double needed = kDirectSolverHeadroom + kBytesPerDof * static_cast<double>(dofs);
+    if (memory.bytes > 0 && memory.bytes < needed) {
+      char text[512];
+      std::snprintf(text, sizeof text, "the direct solver needs about %.2g GB, more than the %.2g GB of %s",
+                    needed / 1e9, memory.bytes / 1e9, memory.source.c_str());
+      if (!automatic)
+        throw InputError((s.solver.where.line ? s.solver.where.str() : s.path) + ": " + at_level + text +
+                         "; set solver.linear_solver: cg_amg (or auto), which needs far less, or raise the "
+                         "limit");
+      warn(at_level + text + "; solving with CG and AMG instead (solver.linear_solver: auto)");
+      p.solver.linear_solver = LinearSolver::kCgAmg;
+    }
+  }
+  try {
+    return solve_elasticity(p);
+  } catch (const DirectSolverError& e) {
+    if (!automatic) throw;
+    warn(at_level + e.what() + "; solving with CG and AMG instead (solver.linear_solver: auto)");
+    p.solver.linear_solver = LinearSolver::kCgAmg;
+    return solve_elasticity(p);
+  }
+}
+
 void solve_level(const Scenario& s, LevelResult& r) {
   ElasticityProblem p;
   p.mesh = &r.mesh;
@@ -846,7 +886,13 @@ void solve_level(const Scenario& s, LevelResult& r) {
     check_held_without_released(s, r, released);
     Progress progress("solve level " + std::to_string(r.level));
     try {
-      r.solution = solve_elasticity(p);
+      r.solution = solve_or_fall_back(s, p, r.level, dofs);
+    } catch (const DirectSolverError& e) {
+      throw RunError((s.solver.where.line ? s.solver.where.str() : s.path) + ": level " +
+                     std::to_string(r.level) + " (" + std::to_string(dofs) +
+                     " degrees of freedom): " + e.what() +
+                     "; give the process more memory, or set solver.linear_solver: cg_amg (or auto), which "
+                     "needs far less");
     } catch (const RunError& e) {
       // The solver speaks of its own options: name the level and the scenario's settings.
       char settings[160];

@@ -1,8 +1,11 @@
 #include "common/system_memory.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -81,6 +84,18 @@ MemoryLimit available_memory(double physical_bytes, const std::string& root,
   return limit;
 }
 
+MemoryLimit with_address_space_limit(MemoryLimit limit, double address_space_bytes, double mapped_bytes) {
+  if (address_space_bytes <= 0) return limit;
+  const double left = std::max(address_space_bytes - std::max(mapped_bytes, 0.0), 1.0);  // 0 is "not known"
+  if (limit.bytes > 0 && left >= limit.bytes) return limit;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "the address space left under this process's limit (ulimit -v: %.3g GB, of which it already "
+                "maps %.3g GB)",
+                address_space_bytes / 1e9, mapped_bytes / 1e9);
+  return {left, text};
+}
+
 MemoryLimit machine_memory() {
   const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
   const double physical =
@@ -88,7 +103,14 @@ MemoryLimit machine_memory() {
   std::ifstream in(kProcSelfCgroup);
   std::ostringstream text;
   text << in.rdbuf();
-  return available_memory(physical, "", text.str());
+  const MemoryLimit limit = available_memory(physical, "", text.str());
+  rlimit address_space{};
+  if (getrlimit(RLIMIT_AS, &address_space) != 0 || address_space.rlim_cur == RLIM_INFINITY) return limit;
+  double mapped_pages = 0;  // the first number of /proc/self/statm: the mapped size in pages
+  std::ifstream statm("/proc/self/statm");
+  statm >> mapped_pages;
+  return with_address_space_limit(limit, static_cast<double>(address_space.rlim_cur),
+                                  mapped_pages * static_cast<double>(page_size));
 }
 
 }  // namespace hexbite

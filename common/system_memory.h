@@ -1,5 +1,6 @@
 // How much memory this process may use: the machine's physical memory, or less when a control group (a
-// container's, a batch job's or a systemd unit's memory limit) caps it. `hexbite run` refuses validation
+// container's, a batch job's or a systemd unit's memory limit) or an address-space limit (ulimit -v) caps
+// it. `hexbite run` refuses validation
 // levels that would need more (app/run_pipeline.cc).
 #pragma once
 
@@ -26,8 +27,15 @@ struct MemoryLimit {
 MemoryLimit available_memory(double physical_bytes, const std::string& root,
                              const std::string& proc_self_cgroup);
 
+// `limit`, or less when an address-space limit (ulimit -v, RLIMIT_AS, as batch schedulers set it) of
+// `address_space_bytes` (0 or less: none) leaves less than that beyond the `mapped_bytes` the process
+// already maps (its libraries and thread stacks: about 1 GB for `hexbite run`, of which a quarter is
+// resident, so the limit binds long before the machine's memory does).
+MemoryLimit with_address_space_limit(MemoryLimit limit, double address_space_bytes, double mapped_bytes);
+
 // available_memory() of this machine (sysconf's physical pages times the page size), its cgroup file
-// systems and its kProcSelfCgroup.
+// systems and its kProcSelfCgroup, with_address_space_limit() of this process's RLIMIT_AS and its mapped
+// size (/proc/self/statm).
 MemoryLimit machine_memory();
 
 }  // namespace hexbite

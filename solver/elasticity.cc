@@ -474,7 +474,14 @@ void ElasticitySolver::solve() {
     SolverControl control(1, 0);
     TrilinosWrappers::SolverDirect direct(
         control, TrilinosWrappers::SolverDirect::AdditionalData(false, "Amesos_Mumps"));
-    direct.solve(system_matrix, distributed_solution, system_rhs);
+    try {
+      direct.solve(system_matrix, distributed_solution, system_rhs);
+    } catch (const ExceptionBase&) {
+      // deal.II's text is a source line and a stack trace; Amesos has printed MUMPS's codes above it.
+      throw DirectSolverError(
+          "elasticity: the direct solver (MUMPS) failed; its lines above give its code (INFOG(1) = -13: it "
+          "could not allocate its workspace, as under a memory or address-space limit, ulimit -v)");
+    }
     solution.iterations = 0;
   } else {
     // The rigid-body modes, mode after mode, over the locally owned rows in the matrix's row order

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/error.h"
 #include "mesher/hex_mesh.h"
 
 namespace hexbite {
@@ -49,6 +50,14 @@ struct SupportPatch {
 };
 
 enum class LinearSolver { kCgAmg, kDirect };
+
+// The direct solver (MUMPS, through Trilinos Amesos) gave up, most often because it could not allocate its
+// workspace (under an address-space limit, `ulimit -v`, as batch schedulers set it). The caller may try CG
+// with AMG, which needs far less memory.
+class DirectSolverError : public RunError {
+ public:
+  using RunError::RunError;
+};
 
 struct SolverSettings {
   LinearSolver linear_solver = LinearSolver::kCgAmg;

@@ -1263,6 +1263,60 @@ TEST(RunMemoryGuard, TheSmallestLimitOfTheProcesssCgroupAndItsAncestorsApplies) 
             "this machine's physical memory");
 }
 
+// An address-space limit (ulimit -v, as batch schedulers set it) was not counted: `hexbite run` maps about
+// 1 GB before it solves (a quarter of it resident), so under 1.0-1.2 GB the direct solver either failed with
+// deal.II's text and a stack trace or hung inside MUMPS, in OpenBLAS retrying a 128 MB buffer forever.
+TEST(RunMemoryGuard, AnAddressSpaceLimitCountsWhatTheProcessAlreadyMaps) {
+  MemoryLimit machine{24e9, "this machine's physical memory"};
+  EXPECT_EQ(with_address_space_limit(machine, 0, 1e9).bytes, 24e9);  // no limit
+  EXPECT_EQ(with_address_space_limit(machine, 64e9, 1e9).bytes, 24e9);
+  const MemoryLimit m = with_address_space_limit(machine, 1.5e9, 1.0e9);
+  EXPECT_DOUBLE_EQ(m.bytes, 0.5e9);
+  EXPECT_NE(m.source.find("ulimit -v: 1.5 GB, of which it already maps 1 GB"), std::string::npos) << m.source;
+  EXPECT_GT(with_address_space_limit(machine, 1e9, 2e9).bytes, 0.0);  // nothing left is not "not known"
+  EXPECT_LT(with_address_space_limit(machine, 1e9, 2e9).bytes, 2.0);
+  EXPECT_DOUBLE_EQ(with_address_space_limit(MemoryLimit{}, 3e9, 1e9).bytes, 2e9);  // a limit when unknown
+}
+
+TEST(RunMemoryGuard, UnderUlimitVTheAutomaticSolverTurnsToCgAndADirectOneIsRefusedBeforeTheSolve) {
+  const std::vector<std::string> limit = {"prlimit", "--as=1300000000", "--"};
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/auto.yaml", kSmall);
+  test::CommandResult r = test::run_hexbite({"run", dir + "/auto.yaml", "-o", dir + "/auto"}, limit);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("level 0 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ulimit -v: 1.3 GB"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("solving with CG and AMG instead (solver.linear_solver: auto)"), std::string::npos)
+      << r.err;
+  const json results = json::parse(test::read_file(dir + "/auto/results.json"));
+  EXPECT_GT(results["solver"]["iterations"].get<int>(), 0);  // CG, not the direct solver (0)
+  EXPECT_GT(results["bite_force_N"].get<double>(), 0.0);
+
+  test::write_file(dir + "/direct.yaml", kSmall + "solver: {linear_solver: direct}\n");
+  r = test::run_hexbite({"run", dir + "/direct.yaml", "-o", dir + "/direct"}, limit);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(dir + "/direct.yaml:11:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the direct solver needs about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("set solver.linear_solver: cg_amg (or auto)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/direct"));
+}
+
+// The validation levels are refused up front when their estimate exceeds what the address-space limit
+// leaves, naming the limit: the shipped-size mesh's level 2 (about 0.8 million DoFs, 4 GB).
+TEST(RunMemoryGuard, ValidationLevelsBeyondAnAddressSpaceLimitAreRefusedNamingIt) {
+  const std::string dir = test::temp_dir();
+  test::write_file(dir + "/levels.yaml", kSmall);
+  const test::CommandResult r =
+      test::run_hexbite({"run", dir + "/levels.yaml", "-o", dir + "/out", "--levels", "2"},
+                        {"prlimit", "--as=2500000000", "--"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--levels 2 would solve level 2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("of the address space left under this process's limit (ulimit -v: 2.5 GB"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 // The summary table's figures (see SummaryTablePrintsTinyFiguresInScientificNotation).
 TEST(RunSummaryTable, FiguresThatFixedPointShowsAsZeroAreInScientificNotation) {
   EXPECT_EQ(format_table_number(0.12345, 5, 14), "       0.12345");
