@@ -236,6 +236,10 @@ int main(int argc, char** argv) {
       return hexbite::kExitBadInput;
     }
     mpi.emplace(argc, argv);
+    // PETSc's initialization inside MPI_InitFinalize pushes and pops its own signal handlers and leaves
+    // SIGTERM and SIGHUP at their default action: a batch system's time limit or a closed terminal then
+    // killed a study without removing its stage folder (helper Z). Installed again.
+    hexbite::remove_temporary_files_on_signals();
   }
   // A reader that closes standard output early (`hexbite quality m.vtu | head -1`) killed the process with
   // SIGPIPE: exit 141 and no word. Ignored, the write fails with EPIPE, and checked_stdout says so (exit 1).

@@ -770,6 +770,23 @@ TEST(Study, TheVariantsAreAnnouncedAtOnceIntoAFile) {
                                                                          << r.out;
 }
 
+// SIGTERM and SIGHUP while a study solved (its hidden stage in the output folder, for minutes) left the
+// folder it created with the empty stage in it: MPI's start-up (PETSc) had reset their handlers, so the
+// process died without cleaning up. Ctrl-C (SIGINT) did clean up.
+TEST(Study, SigtermOrSighupWhileSolvingRemovesTheStageAndTheFolderItCreated) {
+  for (const char* signal_name : {"TERM", "HUP"}) {
+    const std::string dir = study_folder(kStudy), out = dir + "/out";
+    const test::CommandResult r = test::run_hexbite(
+        {"study", dir + "/study.yaml", "-o", out, "--levels", "2"},
+        {"bash", "-c",
+         std::string("\"$@\" & for i in $(seq 600); do compgen -G '") + out +
+             "/.hexbite-stage-*' >/dev/null && break; sleep 0.1; done; kill -" + signal_name + " $!; wait $!",
+         "bash"});
+    EXPECT_EQ(r.exit_code, 128 + (std::string(signal_name) == "TERM" ? SIGTERM : SIGHUP)) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << signal_name << ": left " << out;
+  }
+}
+
 // A missing, empty or non-text base was told "write a word such as left_condyle", the hint for point names.
 TEST(Study, ABaseThatIsNoPathAsksForTheBaseScenariosFile) {
   for (const char* base : {"base: \"\"", "base:", "base: [a]"}) {
