@@ -4,6 +4,7 @@
 #include <mpi.h>
 
 #include <pwd.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -17,6 +18,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -222,7 +224,23 @@ int checked_stdout(int exit_code) {
 
 }  // namespace
 
+// OpenBLAS (deal.II's BLAS) starts a thread per core when it is loaded, and each of them allocates a 128 MB
+// work buffer, retrying forever when it cannot: under an address-space limit (ulimit -v, as batch systems
+// set it) below what the process maps plus those buffers every command hung at its exit with a thread
+// spinning (600 MB on this 2-core machine: `hexbite --version` printed and never ended; a 64-core node's
+// buffers alone take 8 GB). OpenBLAS reads its thread count from OPENBLAS_NUM_THREADS when it is loaded,
+// before main, so under such a limit, unless the user chose a count, hexbite starts itself again with one
+// BLAS thread. Its BLAS work is small (MUMPS factorizes at most 30,000 unknowns unless asked to).
+void one_blas_thread_under_an_address_space_limit(char** argv) {
+  rlimit address_space{};
+  if (getrlimit(RLIMIT_AS, &address_space) != 0 || address_space.rlim_cur == RLIM_INFINITY) return;
+  if (std::getenv("OPENBLAS_NUM_THREADS") != nullptr) return;
+  setenv("OPENBLAS_NUM_THREADS", "1", 1);
+  execv("/proc/self/exe", argv);  // returns only when it failed: go on as before
+}
+
 int main(int argc, char** argv) {
+  one_blas_thread_under_an_address_space_limit(argv);
   // Past a file size limit (ulimit -f) a write raises SIGXFSZ, which killed the process without a word and
   // left its temporary files; ignored, the write fails with EFBIG and the outputs are undone as on a full
   // disk.
@@ -308,6 +326,14 @@ int main(int argc, char** argv) {
     return report(std::string("hexbite: error: ") + e.what() + '\n', hexbite::kExitBadInput, errors);
   } catch (const hexbite::RunError& e) {
     return report(std::string("hexbite: failed: ") + e.what() + '\n', hexbite::kExitRunFailed, errors);
+  } catch (const std::bad_alloc&) {
+    // Said as "std::bad_alloc" before.
+    return report(
+        "hexbite: failed: out of memory: the machine's memory, a container's or batch job's memory limit, "
+        "or the address-space limit (ulimit -v) is too small for this work; give the process more, or ask "
+        "for "
+        "less (fewer hexes, fewer validation levels)\n",
+        hexbite::kExitRunFailed, errors);
   } catch (const std::exception& e) {
     return report(std::string("hexbite: failed: ") + e.what() + '\n', hexbite::kExitRunFailed, errors);
   }

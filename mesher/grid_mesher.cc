@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "common/error.h"
+#include "common/helper_threads.h"
 #include "common/progress.h"
 #include "mesher/arch_frame.h"
 #include "mesher/cell_size_search.h"
@@ -1441,7 +1442,8 @@ static HexMesh grid_mesh_in_frame(const TriSurface& surface, const GridMeshOptio
   };
   {
     std::vector<std::thread> helpers;
-    for (int t = 1; t < std::clamp(options.threads, 1, 4); ++t) helpers.emplace_back(work, true);
+    for (int t = 1; t < std::clamp(options.threads, 1, 4); ++t)
+      if (!start_helper_thread(helpers, [&work] { work(true); })) break;  // the caller takes their jobs
     try {
       attempts[0] = swept ? swept_attempt(grid_projector, lo, hi, options, shifts[0], *arch)
                           : grid_core(grid_projector, grid_shells, lo, hi, grid_volume, mean_thickness,
@@ -1472,7 +1474,7 @@ static HexMesh grid_mesh_in_frame(const TriSurface& surface, const GridMeshOptio
     };
     std::vector<std::thread> helpers;
     for (int t = 1; t < std::clamp(options.threads, 1, int(add.size())); ++t)
-      helpers.emplace_back(work_retry, true);
+      if (!start_helper_thread(helpers, [&work_retry] { work_retry(true); })) break;
     work_retry(false);
     for (std::thread& t : helpers) t.join();
     for (int a = from; a < job_count; ++a)

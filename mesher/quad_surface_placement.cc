@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "common/error.h"
+#include "common/helper_threads.h"
 #include "common/progress.h"
 #include "mesher/hex_boundary.h"
 #include "mesher/mandible_quad_template.h"
@@ -46,11 +47,16 @@ void parallel_for(std::size_t n, int threads, const F& f, std::size_t min_chunk 
     return;
   }
   std::vector<std::thread> helpers;
-  for (std::size_t k = 1; k < t; ++k)
-    helpers.emplace_back([&, k] {
+  std::vector<std::size_t> refused;  // chunks whose thread the system refused: the caller does them
+  for (std::size_t k = 1; k < t; ++k) {
+    const auto chunk = [&, k] {
       for (std::size_t i = n * k / t; i < n * (k + 1) / t; ++i) f(i);
-    });
+    };
+    if (!start_helper_thread(helpers, chunk)) refused.push_back(k);
+  }
   for (std::size_t i = 0; i < n / t; ++i) f(i);
+  for (std::size_t k : refused)
+    for (std::size_t i = n * k / t; i < n * (k + 1) / t; ++i) f(i);
   for (std::thread& h : helpers) h.join();
 }
 

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include <pwd.h>
 #include <sys/stat.h>
@@ -258,6 +260,24 @@ TEST(Cli, SurfaceWhoseComponentsFaceDifferentWaysHasNoVolume) {
   EXPECT_NE(r.out.find("enclosed volume       undefined (the components are oriented inconsistently"),
             std::string::npos)
       << r.out;
+}
+
+// Under an address-space limit (ulimit -v) OpenBLAS's threads, started when it is loaded, retried their 128
+// MB buffers forever: at 600 MB `hexbite --version` printed and never ended, and an out-of-memory mesh said
+// "std::bad_alloc" and then hung the same way. Each command is given 60 s (they take about 1-3 s).
+TEST(Cli, UnderATightAddressSpaceLimitCommandsEndAndOutOfMemoryIsSaidPlainly) {
+  const std::vector<std::string> limit = {"timeout", "60", "prlimit", "--as=600000000", "--"};
+  test::CommandResult r = run_hexbite({"--version"}, limit);
+  EXPECT_EQ(r.exit_code, 0) << r.err;  // 124: timeout had to end it
+  EXPECT_EQ(r.out.rfind("hexbite ", 0), 0u) << r.out;
+
+  const std::string dir = temp_dir();
+  ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/m.stl"}).exit_code, 0);
+  r = run_hexbite({"-q", "mesh", dir + "/m.stl", "--target-hexes", "20000", "-o", dir + "/m.vtu"}, limit);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("hexbite: failed: out of memory: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("address-space limit (ulimit -v)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/m.vtu"));
 }
 
 TEST(CliBadInput, MissingFile) {

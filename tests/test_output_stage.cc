@@ -3,6 +3,7 @@
 #include "common/output_stage.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,15 +17,41 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/helper_threads.h"
 #include "tests/test_util.h"
 
 namespace hexbite {
 namespace {
 
 namespace fs = std::filesystem;
+
+// A thread the system refused (its 8 MB stack beyond an address-space limit) threw std::system_error out of
+// the grid mesher's thread pool, whose started threads then ended the process in std::terminate.
+TEST(HelperThreads, ARefusedThreadIsReportedAndTheCallerDoesTheWork) {
+  std::vector<std::thread> helpers;
+  helpers.reserve(2);
+  bool ran = false;
+  rlimit before{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &before), 0);
+  double mapped_pages = 0;
+  std::ifstream("/proc/self/statm") >> mapped_pages;
+  ASSERT_GT(mapped_pages, 0);
+  rlimit tight = before;
+  tight.rlim_cur = static_cast<rlim_t>(mapped_pages * sysconf(_SC_PAGESIZE)) + (1u << 20);  // 1 MB more
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &tight), 0);
+  const bool started = start_helper_thread(helpers, [&ran] { ran = true; });
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &before), 0);
+  EXPECT_FALSE(started);
+  EXPECT_TRUE(helpers.empty());
+  EXPECT_FALSE(ran);
+  ASSERT_TRUE(start_helper_thread(helpers, [&ran] { ran = true; }));
+  helpers.front().join();
+  EXPECT_TRUE(ran);
+}
 
 bool is_output(const std::string& name) {
   return name.rfind("out_", 0) == 0;
