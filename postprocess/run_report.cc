@@ -148,7 +148,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
       const Vec3 unit = m.magnitude > 0 ? vec3::scale(m.force, 1.0 / m.magnitude) : m.force;
       t.row({text(markup_escape(m.name)), num(m.activation ? activation : "n/a"),
              num(format_newtons(m.magnitude)), text(format_point(unit, 2)),
-             num(format_count(std::lround(m.patch_area_mm2)))});
+             num(format_significant_digits(m.patch_area_mm2, 3))});
     }
   }
   if (r.supports.empty()) return;
@@ -171,7 +171,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
     char radius[32];
     std::snprintf(radius, sizeof radius, "%g", s.radius_mm.value_or(0));
     t.row({text(markup_escape(s.name)), text(condition), text(s.center ? format_point(*s.center) : "n/a"),
-           num(s.radius_mm ? radius : "n/a"), num(format_count(std::lround(s.patch_area_mm2)))});
+           num(s.radius_mm ? radius : "n/a"), num(format_significant_digits(s.patch_area_mm2, 3))});
   }
 }
 

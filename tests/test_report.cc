@@ -179,6 +179,38 @@ TEST_F(Report, HoldsTheFiguresOfResultsJsonFormattedAsDocumented) {
   EXPECT_EQ(html.find("<b>&"), std::string::npos);
 }
 
+// Patch areas and lengths with 3 significant digits, rounded before the form is chosen (reports.md, "How
+// figures are written"): a patch of 0.4 mm2 read "0" and one of 1.19 mm2 "1" (rounded to whole mm2), a
+// displacement of 12345.6 mm "12346", a strain energy of 10696.98 mJ "10697" and one of 999,999.7 mJ
+// "1000000".
+TEST_F(Report, AreasAndLargeFiguresHaveThreeSignificantDigits) {
+  const std::string dir = temp_dir();
+  json j = *results_;
+  j["supports"][0]["patch_area_mm2"] = 0.4;
+  j["muscles"][0]["patch_area_mm2"] = 1.1946187523303051;
+  for (json* level : {&j, &j["validation"]["levels"][0]}) {  // the coarse level, as the run writes it twice
+    (*level)["max_displacement_mm"] = 12345.6;
+    (*level)["strain_energy_mJ"] = 999999.7;
+  }
+  j["validation"]["levels"][1]["strain_energy_mJ"] = 10696.979;
+  write_file(dir + "/results.json", j.dump(1));
+  const test::CommandResult c = run_hexbite({"-q", "report", dir, "-o", dir + "/r.html", "--no-pictures"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const std::string html = read_file(dir + "/r.html");
+  const std::string model = section(html, "Model");
+  EXPECT_NE(model.find("<td>pull</td>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td class=\"n\">1.19</td></tr>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td>nut</td>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td class=\"n\">0.400</td></tr>"), std::string::npos) << model;
+  const std::string results = section(html, "Results");
+  EXPECT_NE(results.find("<td class=\"n\">12300</td>"), std::string::npos) << results;
+  EXPECT_NE(results.find("<td class=\"n\">1.00e+06</td>"), std::string::npos) << results;
+  const std::string validation = section(html, "Validation");
+  EXPECT_NE(validation.find("<td class=\"n\">10700</td>"), std::string::npos) << validation;
+  EXPECT_EQ(html.find("1000000"), std::string::npos);
+  EXPECT_EQ(html.find("12346"), std::string::npos);
+}
+
 TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
   const std::string dir = temp_dir(), tmp = dir + "/tmp";
   fs::create_directories(tmp);
