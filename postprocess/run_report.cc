@@ -303,21 +303,23 @@ void probes_section(std::ostringstream& out, const RunFigures& r) {
     out << "<p>The scenario has no probes.</p>\n";
     return;
   }
-  Table t(out);
-  t.header({text("probe"), text("point (mm)"), text("displacement (mm)"), num("|u| (mm)"),
-            num("von Mises (MPa)"), num("moved (mm)")});
-  for (const ProbeFigures& p : r.coarse.probes) {
-    if (!p.found) {
-      t.row({text(markup_escape(p.name)), text(format_point(p.at)), text("not in the mesh"), num("n/a"),
-             num("n/a"), num(format_mm(p.moved_mm))});
-      continue;
+  {  // the table closed before the note: a <p> inside a <table> is invalid, and browsers move it above
+    Table t(out);
+    t.header({text("probe"), text("point (mm)"), text("displacement (mm)"), num("|u| (mm)"),
+              num("von Mises (MPa)"), num("moved (mm)")});
+    for (const ProbeFigures& p : r.coarse.probes) {
+      if (!p.found) {
+        t.row({text(markup_escape(p.name)), text(format_point(p.at)), text("not in the mesh"), num("n/a"),
+               num("n/a"), num(format_mm(p.moved_mm))});
+        continue;
+      }
+      char u[128];
+      std::snprintf(u, sizeof u, "(%s, %s, %s)", format_mm(p.displacement[0]).c_str(),
+                    format_mm(p.displacement[1]).c_str(), format_mm(p.displacement[2]).c_str());
+      t.row({text(markup_escape(p.name)), text(format_point(p.at)), text(u),
+             num(format_mm(vec3::norm(p.displacement))), num(format_mpa(p.von_mises)),
+             num(format_mm(p.moved_mm))});
     }
-    char u[128];
-    std::snprintf(u, sizeof u, "(%s, %s, %s)", format_mm(p.displacement[0]).c_str(),
-                  format_mm(p.displacement[1]).c_str(), format_mm(p.displacement[2]).c_str());
-    t.row({text(markup_escape(p.name)), text(format_point(p.at)), text(u),
-           num(format_mm(vec3::norm(p.displacement))), num(format_mpa(p.von_mises)),
-           num(format_mm(p.moved_mm))});
   }
   out << "<p class=\"note\">A probe outside the mesh is evaluated at the closest point just inside it; "
          "&ldquo;moved&rdquo; says how far.</p>\n";
