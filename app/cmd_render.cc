@@ -73,7 +73,8 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--height", args->options.height, "Picture height in pixels")
       ->transform(count_in_range(64, 8192))
       ->capture_default_str();
-  cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner");
+  cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner")
+      ->check(one_line_of_text("the title"));
   cmd->add_flag("!--no-edges", args->options.edges, "Do not draw the element edges");
   cmd->callback([args, units, field, max] {
     if (check_render_input(args->input, field->count() > 0, max->count() > 0, units->count() > 0)) {

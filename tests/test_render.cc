@@ -161,10 +161,11 @@ TEST(Render, DamagedMeshIsOneCleanError) {
   EXPECT_FALSE(fs::exists(dir + "/cut.png"));
 }
 
-// Options that the input would ignore, a .vtu named in capitals and non-finite --max values: exit 2 before
-// anything is read or a display is needed. Before: `--field` on a surface and `--max` without `--field` were
-// silently ignored, `--max nan` too, `--max inf` was refused with a 309-digit bound, and `MESH.VTU` was read
-// as a surface ("unknown extension '.vtu'; accepted surface formats are .stl, ...").
+// Options that the input would ignore, a .vtu named in capitals, non-finite --max values and a --title
+// that is not one line of UTF-8: exit 2 before anything is read or a display is needed. Before: `--field` on
+// a surface and `--max` without `--field` were silently ignored, `--max nan` too, `--max inf` was refused
+// with a 309-digit bound, and `MESH.VTU` was read as a surface ("unknown extension '.vtu'; accepted surface
+// formats are .stl, ...").
 TEST(Render, OptionsTheInputIgnoresAreRefused) {
   const std::string dir = temp_dir();
   test::write_file(dir + "/cube.obj", test::cubes_obj(1));
@@ -198,6 +199,11 @@ TEST(Render, OptionsTheInputIgnoresAreRefused) {
       {{"render", dir + "/cube.obj", "--width", "abc", "-o", png},
        "--width: abc is not a number: give a whole number from 64 to 8,192"},
       {{"render", dir + "/cube.obj", "--height", "1e4", "-o", png}, "--height: 1e4 is out of range"},
+      // A caption VTK cannot draw: it was dropped from the picture, with VTK's errors, and exit 0.
+      {{"render", dir + "/cube.obj", "--title", "r\xe9sum\xe9", "-o", png},
+       "--title: the title is not valid UTF-8 (byte 0xE9 at position 2)"},
+      {{"render", dir + "/cube.obj", "--title", "a\x1b[1m", "-o", png},
+       "--title: the title holds a control character (0x1B)"},
   };
   for (const Case& c : cases) {
     const auto r = run_hexbite(c.args);

@@ -538,6 +538,21 @@ TEST_F(Report, ValuesNoRunWritesAndABlankTitleAreRefused) {
     EXPECT_NE(r.err.find("the title is blank"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
+  // A Latin-1 title made the report invalid UTF-8 (it declares utf-8), a control character invalid HTML.
+  const std::vector<std::pair<std::string, std::string>> titles = {
+      {"r\xe9sum\xe9", "--title: the title is not valid UTF-8 (byte 0xE9 at position 2): give it in UTF-8"},
+      {"a\x01"
+       "b",
+       "--title: the title holds a control character (0x01); it is one line of printable text: remove it"},
+      {"two\nlines", "--title: the title holds a control character (0x0A, a line break)"},
+  };
+  for (const auto& [title, message] : titles) {
+    const test::CommandResult r =
+        run_hexbite({"report", *run_dir_, "-o", out, "--no-pictures", "--title", title});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 // A .pvtu whose piece is missing was "cannot read 'solution.pvtu' ... (VTK: File for piece 0 cannot be
