@@ -8,6 +8,7 @@
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkLookupTable.h>
 #include <vtkMapper.h>
+#include <vtkMath.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
@@ -33,6 +34,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -121,8 +123,9 @@ std::array<double, 4> view_extent(vtkCamera* camera, vtkDataSet* data, double as
 }
 
 // Zooms and shifts the camera until the object's points fill the picture with a margin, left of the
-// colour legend when there is one. VTK's ResetCamera fits the bounding sphere into the vertical view
-// angle only, and the fixed zoom used before cut off tall objects, and wide ones in portrait pictures.
+// colour legend when there is one, across as well as up. VTK's ResetCamera fits the bounding sphere into the
+// vertical view angle only, and the fixed zoom used before cut off tall objects, and wide ones in portrait
+// pictures.
 void frame_object(vtkRenderer* renderer, vtkActor* actor, double aspect, bool legend) {
   vtkCamera* camera = renderer->GetActiveCamera();
   actor->GetMapper()->Update();
@@ -130,13 +133,20 @@ void frame_object(vtkRenderer* renderer, vtkActor* actor, double aspect, bool le
   if (data == nullptr || data->GetNumberOfPoints() == 0) return;
   // The legend (vtkScalarBarActor's default place) starts at 0.82 of the width: x = 0.64.
   const double x0 = -0.94, x1 = legend ? 0.56 : 0.94, y0 = -0.9, y1 = 0.92;
-  // A zoom changes the view angle, and the perspective makes the fit not quite linear: a few rounds.
-  for (int round = 0; round < 4; ++round) {
+  // The view angle spans the picture's shorter side, so that it stays well below VTK's limit of 179
+  // degrees whatever the picture's shape.
+  camera->SetUseHorizontalViewAngle(aspect < 1);
+  for (int round = 0; round < 3; ++round) {
     renderer->ResetCameraClippingRange();
     std::array<double, 4> e = view_extent(camera, data, aspect);
     const double scale =
         std::min((x1 - x0) / std::max(e[1] - e[0], 1e-12), (y1 - y0) / std::max(e[3] - e[2], 1e-12));
-    camera->Zoom(scale);
+    // The object's extent in the picture is proportional to 1 / tan(angle / 2), so that is what is scaled.
+    // vtkCamera::Zoom divides the angle itself, far from that at wide angles: a tall narrow picture needed
+    // them to take in the object's width, overshot and never settled, and cut the object off at both sides
+    // or left it out of the picture.
+    const double half_angle = vtkMath::RadiansFromDegrees(camera->GetViewAngle()) / 2;
+    camera->SetViewAngle(vtkMath::DegreesFromRadians(2 * std::atan(std::tan(half_angle) / scale)));
     e = view_extent(camera, data, aspect);
     double centre[2];
     camera->GetWindowCenter(centre);
