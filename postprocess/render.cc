@@ -301,16 +301,45 @@ RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& fie
   vtkDataArray* array = grid->GetPointData()->GetArray(field.c_str());
   const bool per_cell = array == nullptr && grid->GetCellData()->GetArray(field.c_str()) != nullptr;
   if (per_cell) array = grid->GetCellData()->GetArray(field.c_str());
-  if (array == nullptr) {
+  // The names of the file's arrays, or of its arrays of one component only.
+  const auto array_names = [&](bool scalars_only) {
     std::string names;
-    for (int i = 0; i < grid->GetPointData()->GetNumberOfArrays(); ++i)
-      names += std::string(names.empty() ? "" : ", ") + grid->GetPointData()->GetArrayName(i);
-    for (int i = 0; i < grid->GetCellData()->GetNumberOfArrays(); ++i)
-      names += std::string(names.empty() ? "" : ", ") + grid->GetCellData()->GetArrayName(i) + " (per hex)";
+    for (auto [data, per_hex] : {std::pair{static_cast<vtkFieldData*>(grid->GetPointData()), ""},
+                                 std::pair{static_cast<vtkFieldData*>(grid->GetCellData()), " (per hex)"}})
+      for (int i = 0; i < data->GetNumberOfArrays(); ++i)
+        if (!scalars_only ||
+            (data->GetArray(i) != nullptr && data->GetArray(i)->GetNumberOfComponents() == 1))
+          names += std::string(names.empty() ? "" : ", ") + data->GetArrayName(i) + per_hex;
+    return names.empty() ? std::string("none") : names;
+  };
+  if (array == nullptr)
     throw InputError("'" + vtu_path + "' has no point or cell array '" + field +
-                     "'; available: " + (names.empty() ? "none" : names));
-  }
-  const int component = array->GetNumberOfComponents() == 1 ? 0 : -1;  // -1: magnitude
+                     "'; available: " + array_names(false));
+  // One component, the magnitude of the displacement vector (as documented), or the component that
+  // --component picks. Before, every array of several components was coloured by its norm: the stress
+  // tensor's 6 components by sqrt(xx^2 + ... + xz^2), which is no stress measure, and the principal
+  // stresses without their sign, compression in the colour of tension.
+  const int components = array->GetNumberOfComponents();
+  const std::string what = "'" + field + "' in '" + vtu_path + "'";
+  std::string component_names;
+  for (int c = 0; c < components; ++c)
+    component_names += (c == 0 ? "" : ", ") + std::to_string(c) +
+                       (array->GetComponentName(c) ? std::string(" ") + array->GetComponentName(c) : "");
+  if (components == 1 && options.component >= 0)
+    throw InputError(what + " has one component: drop --component");
+  const bool magnitude = components == 3 && !per_cell && field == "displacement" && options.component < 0;
+  if (components > 1 && !magnitude && options.component < 0)
+    throw InputError(
+        what + " has " + std::to_string(components) + " components (" + component_names +
+        "): pick one with --component N, or colour by an array of one component: " + array_names(true));
+  if (options.component >= components)
+    throw InputError("--component " + std::to_string(options.component) + " is not a component of " + what +
+                     ", which has " + std::to_string(components) + " (" + component_names + ")");
+  const int component = components == 1 ? 0 : magnitude ? -1 : options.component;  // -1: magnitude
+  std::string legend = field;
+  if (component >= 0 && components > 1)
+    legend += array->GetComponentName(component) ? std::string(" ") + array->GetComponentName(component)
+                                                 : " component " + std::to_string(component);
   double range[2];
   array->GetRange(range, component);
   drawn.field_max = range[1];
@@ -335,11 +364,16 @@ RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& fie
   else
     mapper->SetScalarModeToUsePointFieldData();
   mapper->SelectColorArray(field.c_str());
-  if (component < 0) colours->SetVectorModeToMagnitude();
+  if (component < 0) {
+    colours->SetVectorModeToMagnitude();
+  } else {
+    colours->SetVectorModeToComponent();
+    colours->SetVectorComponent(component);
+  }
   mapper->SetScalarRange(range);
   mapper->ScalarVisibilityOn();
   bar->SetLookupTable(colours);
-  bar->SetTitle(field.c_str());
+  bar->SetTitle(legend.c_str());
   bar->SetNumberOfLabels(5);
   bar->SetMaximumWidthInPixels(110);
   // VTK draws the title right on top of the bar, where it touched the top label ("von_mises" over "10.0").

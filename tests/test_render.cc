@@ -161,6 +161,71 @@ TEST(Render, TheWholeObjectIsInThePicture) {
   }
 }
 
+// An array of several components is coloured by the one --component picks; without it only the
+// displacement is drawn (by its magnitude), and any other such array is refused naming its components and the
+// arrays of one. Before, `--field stress` was coloured by sqrt(xx^2 + yy^2 + zz^2 + xy^2 + yz^2 + xz^2),
+// which is no stress measure, and `--field principal_stress` by a norm that lost every sign.
+TEST(Render, AnArrayOfSeveralComponentsNeedsAComponent) {
+  const std::string dir = temp_dir(), vtu = dir + "/hex.vtu", png = dir + "/p.png";
+  test::write_file(
+      vtu,
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\">\n"
+      "<UnstructuredGrid><Piece NumberOfPoints=\"8\" NumberOfCells=\"1\">\n"
+      "<PointData><DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
+      "format=\"ascii\">"
+      "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1</DataArray>\n"
+      "<DataArray type=\"Float64\" Name=\"von_mises\" format=\"ascii\">1 2 3 4 5 6 7 "
+      "8</DataArray></PointData>\n"
+      "<CellData><DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">"
+      "-9 2 3 4 5 6</DataArray>\n"
+      "<DataArray type=\"Float64\" Name=\"principal_stress\" NumberOfComponents=\"3\" "
+      "ComponentName0=\"largest\" "
+      "ComponentName1=\"middle\" ComponentName2=\"smallest\" format=\"ascii\">12 -1 "
+      "-14</DataArray></CellData>\n"
+      "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+      "0 0 0 10 0 0 10 10 0 0 10 0 0 0 10 10 0 10 10 10 10 0 10 10</DataArray></Points>\n"
+      "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3 4 5 6 7</DataArray>\n"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">8</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">12</DataArray></Cells>\n"
+      "</Piece></UnstructuredGrid></VTKFile>\n");
+  struct Case {
+    std::string options, fragment;
+  };
+  const std::vector<Case> refused = {
+      {"--field stress",
+       "'stress' in '" + vtu +
+           "' has 6 components (0, 1, 2, 3, 4, 5): pick one with --component N, or colour by an array of one "
+           "component: von_mises"},
+      {"--field principal_stress", "has 3 components (0 largest, 1 middle, 2 smallest): pick one"},
+      {"--field stress --component 6",
+       "--component 6 is not a component of 'stress' in '" + vtu + "', which has 6 (0, 1, 2, 3, 4, 5)"},
+      {"--field von_mises --component 0", "'von_mises' in '" + vtu + "' has one component: drop --component"},
+      {"--component 1", "--component picks a component of the array of --field, and no --field is given"},
+  };
+  for (const Case& c : refused) {
+    EXPECT_EQ(
+        run_with_prefix(display_prefix(), "render '" + vtu + "' -o '" + png + "' " + c.options, dir + "/log"),
+        2)
+        << c.options << "\n"
+        << read_file(dir + "/log");
+    EXPECT_NE(read_file(dir + "/log").find(c.fragment), std::string::npos) << read_file(dir + "/log");
+    EXPECT_FALSE(fs::exists(png)) << c.options;
+  }
+  for (const std::string options : {"--field stress --component 0", "--field principal_stress --component 2",
+                                    "--field displacement", "--field displacement --component 2"}) {
+    EXPECT_EQ(run_with_prefix(display_prefix(),
+                              "render '" + vtu + "' -o '" + png + "' --width 320 --height 200 " + options,
+                              dir + "/log"),
+              0)
+        << options << "\n"
+        << read_file(dir + "/log");
+    EXPECT_EQ(read_file(dir + "/log").find("ERR"), std::string::npos) << read_file(dir + "/log");
+    EXPECT_TRUE(fs::exists(png)) << options;
+    fs::remove(png);
+  }
+}
+
 // A cut-off VTU: one error line with VTK's explanation in it, not VTK's own coloured multi-line log.
 TEST(Render, DamagedMeshIsOneCleanError) {
   const std::string dir = temp_dir();
