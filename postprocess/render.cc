@@ -30,6 +30,7 @@
 #include <vtkXMLReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
+#include <GL/glx.h>
 #include <X11/Xlib.h>
 
 #include <algorithm>
@@ -57,6 +58,32 @@ std::string display_problem() {
   // one leaves, and VTK's own connection, made right after, was refused now and then during that reset.
   static Display* const probe = XOpenDisplay(nullptr);
   if (probe == nullptr) return std::string("the X display '") + display + "' does not answer";
+  // A display that answers but cannot give VTK an OpenGL context (an X server without the GLX extension,
+  // as many ssh -X and VNC servers are, or an 8-bit screen without a colour visual with a depth buffer):
+  // VTK aborted on it ("Could not find a decent config", exit 134), and `report` left its temporary folder.
+  int error_base = 0, event_base = 0;
+  if (!glXQueryExtension(probe, &error_base, &event_base))
+    return std::string("the X display '") + display +
+           "' has no OpenGL: its X server lacks the GLX extension";
+  const int attributes[] = {GLX_DRAWABLE_TYPE,
+                            GLX_WINDOW_BIT,
+                            GLX_RENDER_TYPE,
+                            GLX_RGBA_BIT,
+                            GLX_RED_SIZE,
+                            1,
+                            GLX_GREEN_SIZE,
+                            1,
+                            GLX_BLUE_SIZE,
+                            1,
+                            GLX_DEPTH_SIZE,
+                            1,
+                            None};
+  int configs = 0;
+  GLXFBConfig* found = glXChooseFBConfig(probe, DefaultScreen(probe), attributes, &configs);
+  if (found != nullptr) XFree(found);
+  if (configs == 0)
+    return std::string("the X display '") + display +
+           "' has no OpenGL: no visual with colour and depth (a screen of 8 bits per pixel?)";
   return {};
 }
 

@@ -17,9 +17,9 @@ struct RenderOptions {
   int component = -1;     // the component of a field of several; -1 = none given
 };
 
-// Why VTK cannot open a window here ("DISPLAY is not set", "the X display ':77' does not answer"), or
-// empty when it can. Rendering without a display aborts inside VTK (exit 134), so callers check this first
-// and tell the user to run under `xvfb-run -a`.
+// Why VTK cannot open a window here ("DISPLAY is not set", "the X display ':77' does not answer", "the X
+// display ':77' has no OpenGL ..."), or empty when it can. Rendering without a display aborts inside VTK
+// (exit 134), so callers check this first and tell the user to run under `xvfb-run -a`.
 std::string display_problem();
 
 // Renders the triangle surface and writes a PNG atomically. Throws RunError when no display.

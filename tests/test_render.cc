@@ -352,5 +352,29 @@ TEST(Render, WithoutDisplayFailsClearlyAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir + "/jaw.png"));
 }
 
+// A display that answers but cannot give an OpenGL context: VTK aborted on it (exit 134, "Could not find a
+// decent config") without a word of hexbite's. Now it is refused as a display that does not answer is.
+TEST(Render, ADisplayWithoutOpenGlFailsClearlyAndWritesNothing) {
+  const std::string dir = temp_dir(), png = dir + "/cube.png";
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  struct Case {
+    std::vector<std::string> options;
+    std::string fragment;
+  };
+  for (const Case& c : {Case{{"-extension", "GLX"}, "has no OpenGL: its X server lacks the GLX extension"},
+                        Case{{"-screen", "0", "640x480x8"}, "has no OpenGL: "}}) {
+    const test::VirtualDisplay x(c.options);
+    if (x.display().empty()) GTEST_SKIP() << "no X server for this test: " << x.problem();
+    EXPECT_EQ(run_with_prefix("env DISPLAY=" + x.display(), "render '" + dir + "/cube.obj' -o '" + png + "'",
+                              dir + "/log"),
+              1);
+    const std::string log = read_file(dir + "/log");
+    EXPECT_NE(log.find("no X display (the X display '" + x.display() + "' " + c.fragment), std::string::npos)
+        << log;
+    EXPECT_NE(log.find("); run the command under `xvfb-run -a`"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(png));
+  }
+}
+
 }  // namespace
 }  // namespace hexbite

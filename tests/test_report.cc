@@ -278,6 +278,26 @@ TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
   EXPECT_FALSE(fs::exists(dir + "/bad.html"));
 }
 
+// A display that answers but has no OpenGL (an X server without GLX, as many ssh -X and VNC servers are):
+// VTK aborted (exit 134) and left the pictures' temporary folder behind.
+TEST_F(Report, ADisplayWithoutOpenGlIsRefusedAndLeavesNothing) {
+  const test::VirtualDisplay x({"-extension", "GLX"});
+  if (x.display().empty()) GTEST_SKIP() << "no X server for this test: " << x.problem();
+  const std::string dir = temp_dir(), tmp = dir + "/tmp";
+  fs::create_directories(tmp);
+  const test::CommandResult r = run_hexbite({"-q", "report", *run_dir_, "-o", dir + "/r.html"},
+                                            {"env", "DISPLAY=" + x.display(), "TMPDIR=" + tmp});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot draw the report's pictures: no X display (the X display '" + x.display() +
+                       "' has no OpenGL: its X server lacks the GLX extension"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("run the command under `xvfb-run -a`, or add --no-pictures"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/r.html"));
+  EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
+}
+
 // A TMPDIR that filled up while the pictures were drawn there was blamed on the report's folder ("make room
 // on the disk or choose another output folder"). A file size limit fails the pictures' writes as a full disk
 // does.
