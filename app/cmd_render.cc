@@ -18,10 +18,10 @@ namespace hexbite {
 namespace {
 
 // Options that the input would ignore are refused before anything is read (as `mesh` refuses its own):
-// `--field` and `--max` colour a mesh's arrays, which a surface has none of; `--units` scales a surface, and
-// a .vtu is read in mm. Returns whether the input is a mesh (a .vtu, or the .pvtu of a run under mpirun, in
-// any case).
-bool check_render_input(const std::string& input, bool field, bool max, bool units) {
+// `--field`, `--max` and `--component` colour a mesh's arrays, which a surface has none of; `--units` scales
+// a surface, and a .vtu is read in mm. Returns whether the input is a mesh (a .vtu, or the .pvtu of a run
+// under mpirun, in any case).
+bool check_render_input(const std::string& input, bool field, bool max, bool component, bool units) {
   const std::string ext = lower_extension(input);
   const bool mesh = ext == ".vtu" || ext == ".pvtu";
   if (!mesh && ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".vtp")
@@ -36,6 +36,10 @@ bool check_render_input(const std::string& input, bool field, bool max, bool uni
     throw InputError(
         "--max caps the colour scale of --field, and no --field is given: drop --max, or add "
         "--field NAME");
+  if (component && !field)
+    throw InputError(
+        "--component picks a component of the array of --field, and no --field is given: drop --component, "
+        "or add --field NAME");
   if (mesh && units)
     throw InputError("--units gives the unit of a surface input, but '" + input +
                      "' is a mesh, read in mm: drop --units");
@@ -56,8 +60,14 @@ void add_render_command(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", args->output, "PNG file to write")->required()->check(output_file({".png"}));
   CLI::Option* units = cmd->add_option("--units", args->units, "Length unit of a surface input: mm, cm or m");
-  CLI::Option* field = cmd->add_option("--field", args->field,
-                                       "VTU only: colour by this point array (e.g. von_mises, displacement)");
+  CLI::Option* field =
+      cmd->add_option("--field", args->field,
+                      "VTU only: colour by this point array (e.g. von_mises, displacement), else cell array");
+  CLI::Option* component =
+      cmd->add_option("--component", args->options.component,
+                      "With --field: the component of an array of several (e.g. 0 for stress xx); needed "
+                      "for all but the displacement, drawn by its magnitude without it")
+          ->transform(count_in_range(0, 99));
   // Finite (CLI::PositiveNumber let NaN through, and answered inf with a 309-digit upper bound).
   CLI::Option* max =
       cmd->add_option("--max", args->options.colour_max,
@@ -73,10 +83,12 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--height", args->options.height, "Picture height in pixels")
       ->transform(count_in_range(64, 8192))
       ->capture_default_str();
-  cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner");
+  cmd->add_option("--title", args->options.title, "Caption drawn in the lower left corner")
+      ->check(one_line_of_text("the title"));
   cmd->add_flag("!--no-edges", args->options.edges, "Do not draw the element edges");
-  cmd->callback([args, units, field, max] {
-    if (check_render_input(args->input, field->count() > 0, max->count() > 0, units->count() > 0)) {
+  cmd->callback([args, units, field, max, component] {
+    if (check_render_input(args->input, field->count() > 0, max->count() > 0, component->count() > 0,
+                           units->count() > 0)) {
       render_mesh_png(args->input, args->field, args->output, args->options);
     } else {
       const TriSurface surface = read_surface(args->input, unit_to_mm(args->units));

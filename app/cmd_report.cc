@@ -114,7 +114,8 @@ void add_report_command(CLI::App& app) {
         return title.find_first_not_of(" \t\r\n") == std::string::npos
                    ? "the title is blank; give some text, or leave out --title for the scenario's name"
                    : "";
-      });
+      })
+      ->check(one_line_of_text("the title"));
   cmd->add_flag("--no-pictures", args->no_pictures,
                 "Leave out the pictures (they need solution.vtu and an X display)");
   cmd->add_flag("--json", args->json, "Print a JSON summary: the report's path, its pictures and warnings");

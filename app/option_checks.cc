@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "common/paths.h"
+#include "common/text_check.h"
 
 namespace hexbite {
 namespace {
@@ -128,6 +129,21 @@ CLI::Validator number_in_range(double lo, double hi, const std::string& range) {
       [lo, hi, give](std::string& value) -> std::string {
         double number = 0;
         return out_of_range(value, lo, hi, give, &number);
+      },
+      "");
+}
+
+CLI::Validator one_line_of_text(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& value) -> std::string {
+        const std::string not_utf8 = utf8_problem(value);
+        if (!not_utf8.empty())
+          return what + " " + not_utf8 +
+                 ": give it in UTF-8 (a terminal or script set to another encoding, such as Latin-1, sends "
+                 "other bytes; `iconv -f latin1 -t utf-8` converts such text)";
+        const std::string control = control_character_problem(value);
+        if (!control.empty()) return what + " " + control + "; it is one line of printable text: remove it";
+        return {};
       },
       "");
 }

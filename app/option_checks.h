@@ -18,6 +18,12 @@ CLI::Validator count_in_range(long lo, long hi);
 // every comparison with it is false) with a message that gives the range, `range` ("from -0.8 to 2").
 CLI::Validator number_in_range(double lo, double hi, const std::string& range);
 
+// Text that goes into a heading of the output (a --title, `what` is "the title"): refuses bytes that are
+// not UTF-8 and control characters, with what to do, as a scenario's names are refused. Before, a Latin-1
+// title made the report's HTML invalid UTF-8 (it declares utf-8), a control character invalid HTML, and
+// `render` dropped such a caption from the picture and still said "wrote".
+CLI::Validator one_line_of_text(const std::string& what);
+
 // An output file: its folder exists, it is not itself a folder, and it ends (in any case) in one of
 // `extensions` (".vtu", or ".nii.gz"), the formats the command writes. Checked before the work, so a typo
 // in -o does not cost a whole meshing run, and a .txt name never gets a VTU written into it.

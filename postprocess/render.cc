@@ -8,6 +8,7 @@
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkLookupTable.h>
 #include <vtkMapper.h>
+#include <vtkMath.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
@@ -29,10 +30,12 @@
 #include <vtkXMLReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
+#include <GL/glx.h>
 #include <X11/Xlib.h>
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -55,6 +58,32 @@ std::string display_problem() {
   // one leaves, and VTK's own connection, made right after, was refused now and then during that reset.
   static Display* const probe = XOpenDisplay(nullptr);
   if (probe == nullptr) return std::string("the X display '") + display + "' does not answer";
+  // A display that answers but cannot give VTK an OpenGL context (an X server without the GLX extension,
+  // as many ssh -X and VNC servers are, or an 8-bit screen without a colour visual with a depth buffer):
+  // VTK aborted on it ("Could not find a decent config", exit 134), and `report` left its temporary folder.
+  int error_base = 0, event_base = 0;
+  if (!glXQueryExtension(probe, &error_base, &event_base))
+    return std::string("the X display '") + display +
+           "' has no OpenGL: its X server lacks the GLX extension";
+  const int attributes[] = {GLX_DRAWABLE_TYPE,
+                            GLX_WINDOW_BIT,
+                            GLX_RENDER_TYPE,
+                            GLX_RGBA_BIT,
+                            GLX_RED_SIZE,
+                            1,
+                            GLX_GREEN_SIZE,
+                            1,
+                            GLX_BLUE_SIZE,
+                            1,
+                            GLX_DEPTH_SIZE,
+                            1,
+                            None};
+  int configs = 0;
+  GLXFBConfig* found = glXChooseFBConfig(probe, DefaultScreen(probe), attributes, &configs);
+  if (found != nullptr) XFree(found);
+  if (configs == 0)
+    return std::string("the X display '") + display +
+           "' has no OpenGL: no visual with colour and depth (a screen of 8 bits per pixel?)";
   return {};
 }
 
@@ -121,8 +150,9 @@ std::array<double, 4> view_extent(vtkCamera* camera, vtkDataSet* data, double as
 }
 
 // Zooms and shifts the camera until the object's points fill the picture with a margin, left of the
-// colour legend when there is one. VTK's ResetCamera fits the bounding sphere into the vertical view
-// angle only, and the fixed zoom used before cut off tall objects, and wide ones in portrait pictures.
+// colour legend when there is one, across as well as up. VTK's ResetCamera fits the bounding sphere into the
+// vertical view angle only, and the fixed zoom used before cut off tall objects, and wide ones in portrait
+// pictures.
 void frame_object(vtkRenderer* renderer, vtkActor* actor, double aspect, bool legend) {
   vtkCamera* camera = renderer->GetActiveCamera();
   actor->GetMapper()->Update();
@@ -130,13 +160,20 @@ void frame_object(vtkRenderer* renderer, vtkActor* actor, double aspect, bool le
   if (data == nullptr || data->GetNumberOfPoints() == 0) return;
   // The legend (vtkScalarBarActor's default place) starts at 0.82 of the width: x = 0.64.
   const double x0 = -0.94, x1 = legend ? 0.56 : 0.94, y0 = -0.9, y1 = 0.92;
-  // A zoom changes the view angle, and the perspective makes the fit not quite linear: a few rounds.
-  for (int round = 0; round < 4; ++round) {
+  // The view angle spans the picture's shorter side, so that it stays well below VTK's limit of 179
+  // degrees whatever the picture's shape.
+  camera->SetUseHorizontalViewAngle(aspect < 1);
+  for (int round = 0; round < 3; ++round) {
     renderer->ResetCameraClippingRange();
     std::array<double, 4> e = view_extent(camera, data, aspect);
     const double scale =
         std::min((x1 - x0) / std::max(e[1] - e[0], 1e-12), (y1 - y0) / std::max(e[3] - e[2], 1e-12));
-    camera->Zoom(scale);
+    // The object's extent in the picture is proportional to 1 / tan(angle / 2), so that is what is scaled.
+    // vtkCamera::Zoom divides the angle itself, far from that at wide angles: a tall narrow picture needed
+    // them to take in the object's width, overshot and never settled, and cut the object off at both sides
+    // or left it out of the picture.
+    const double half_angle = vtkMath::RadiansFromDegrees(camera->GetViewAngle()) / 2;
+    camera->SetViewAngle(vtkMath::DegreesFromRadians(2 * std::atan(std::tan(half_angle) / scale)));
     e = view_extent(camera, data, aspect);
     double centre[2];
     camera->GetWindowCenter(centre);
@@ -291,16 +328,45 @@ RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& fie
   vtkDataArray* array = grid->GetPointData()->GetArray(field.c_str());
   const bool per_cell = array == nullptr && grid->GetCellData()->GetArray(field.c_str()) != nullptr;
   if (per_cell) array = grid->GetCellData()->GetArray(field.c_str());
-  if (array == nullptr) {
+  // The names of the file's arrays, or of its arrays of one component only.
+  const auto array_names = [&](bool scalars_only) {
     std::string names;
-    for (int i = 0; i < grid->GetPointData()->GetNumberOfArrays(); ++i)
-      names += std::string(names.empty() ? "" : ", ") + grid->GetPointData()->GetArrayName(i);
-    for (int i = 0; i < grid->GetCellData()->GetNumberOfArrays(); ++i)
-      names += std::string(names.empty() ? "" : ", ") + grid->GetCellData()->GetArrayName(i) + " (per hex)";
+    for (auto [data, per_hex] : {std::pair{static_cast<vtkFieldData*>(grid->GetPointData()), ""},
+                                 std::pair{static_cast<vtkFieldData*>(grid->GetCellData()), " (per hex)"}})
+      for (int i = 0; i < data->GetNumberOfArrays(); ++i)
+        if (!scalars_only ||
+            (data->GetArray(i) != nullptr && data->GetArray(i)->GetNumberOfComponents() == 1))
+          names += std::string(names.empty() ? "" : ", ") + data->GetArrayName(i) + per_hex;
+    return names.empty() ? std::string("none") : names;
+  };
+  if (array == nullptr)
     throw InputError("'" + vtu_path + "' has no point or cell array '" + field +
-                     "'; available: " + (names.empty() ? "none" : names));
-  }
-  const int component = array->GetNumberOfComponents() == 1 ? 0 : -1;  // -1: magnitude
+                     "'; available: " + array_names(false));
+  // One component, the magnitude of the displacement vector (as documented), or the component that
+  // --component picks. Before, every array of several components was coloured by its norm: the stress
+  // tensor's 6 components by sqrt(xx^2 + ... + xz^2), which is no stress measure, and the principal
+  // stresses without their sign, compression in the colour of tension.
+  const int components = array->GetNumberOfComponents();
+  const std::string what = "'" + field + "' in '" + vtu_path + "'";
+  std::string component_names;
+  for (int c = 0; c < components; ++c)
+    component_names += (c == 0 ? "" : ", ") + std::to_string(c) +
+                       (array->GetComponentName(c) ? std::string(" ") + array->GetComponentName(c) : "");
+  if (components == 1 && options.component >= 0)
+    throw InputError(what + " has one component: drop --component");
+  const bool magnitude = components == 3 && !per_cell && field == "displacement" && options.component < 0;
+  if (components > 1 && !magnitude && options.component < 0)
+    throw InputError(
+        what + " has " + std::to_string(components) + " components (" + component_names +
+        "): pick one with --component N, or colour by an array of one component: " + array_names(true));
+  if (options.component >= components)
+    throw InputError("--component " + std::to_string(options.component) + " is not a component of " + what +
+                     ", which has " + std::to_string(components) + " (" + component_names + ")");
+  const int component = components == 1 ? 0 : magnitude ? -1 : options.component;  // -1: magnitude
+  std::string legend = field;
+  if (component >= 0 && components > 1)
+    legend += array->GetComponentName(component) ? std::string(" ") + array->GetComponentName(component)
+                                                 : " component " + std::to_string(component);
   double range[2];
   array->GetRange(range, component);
   drawn.field_max = range[1];
@@ -325,11 +391,16 @@ RenderedMesh render_mesh_png(const std::string& vtu_path, const std::string& fie
   else
     mapper->SetScalarModeToUsePointFieldData();
   mapper->SelectColorArray(field.c_str());
-  if (component < 0) colours->SetVectorModeToMagnitude();
+  if (component < 0) {
+    colours->SetVectorModeToMagnitude();
+  } else {
+    colours->SetVectorModeToComponent();
+    colours->SetVectorComponent(component);
+  }
   mapper->SetScalarRange(range);
   mapper->ScalarVisibilityOn();
   bar->SetLookupTable(colours);
-  bar->SetTitle(field.c_str());
+  bar->SetTitle(legend.c_str());
   bar->SetNumberOfLabels(5);
   bar->SetMaximumWidthInPixels(110);
   // VTK draws the title right on top of the bar, where it touched the top label ("von_mises" over "10.0").

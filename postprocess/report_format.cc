@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 #include "common/number_format.h"
 
@@ -15,12 +17,13 @@ std::string format_newtons(double n) {
 std::string format_significant_digits(double value, int digits) {
   if (value == 0) return "0";
   if (!std::isfinite(value)) return std::isnan(value) ? "n/a" : (value > 0 ? "inf" : "-inf");
-  const int exponent = static_cast<int>(std::floor(std::log10(std::fabs(value))));
+  // Rounded to `digits` first, and the form chosen by the rounded figure: the exponent of the value itself
+  // printed 999,999.7 as a 7-digit "1000000", and every integer digit of 10696.98 ("10697", not "10700").
   char text[64];
-  if (exponent < -3 || exponent > 5)
-    std::snprintf(text, sizeof text, "%.*e", digits - 1, value);
-  else
-    std::snprintf(text, sizeof text, "%.*f", std::max(0, digits - 1 - exponent), value);
+  std::snprintf(text, sizeof text, "%.*e", digits - 1, value);
+  const int exponent = std::atoi(std::strchr(text, 'e') + 1);
+  if (exponent < -3 || exponent > 5) return text;
+  std::snprintf(text, sizeof text, "%.*f", std::max(0, digits - 1 - exponent), std::strtod(text, nullptr));
   return text;
 }
 

@@ -11,8 +11,9 @@ namespace hexbite {
 
 // Newtons with 1 decimal: "367.0".
 std::string format_newtons(double n);
-// `digits` significant digits, in fixed point from 0.001 to 999,999 ("0.0292", "118"), otherwise in
-// scientific notation ("3.00e-07"): millimetres and millijoules take 3.
+// `digits` significant digits: rounded to them, in fixed point from 0.001 to 999,999 ("0.0292", "118",
+// "10700"), otherwise in scientific notation ("3.00e-07", "1.00e+06" for 999,999.7): millimetres, square
+// millimetres and millijoules take 3.
 std::string format_significant_digits(double value, int digits);
 // Millimetres with 3 significant digits.
 std::string format_mm(double mm);

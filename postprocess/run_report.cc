@@ -148,7 +148,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
       const Vec3 unit = m.magnitude > 0 ? vec3::scale(m.force, 1.0 / m.magnitude) : m.force;
       t.row({text(markup_escape(m.name)), num(m.activation ? activation : "n/a"),
              num(format_newtons(m.magnitude)), text(format_point(unit, 2)),
-             num(format_count(std::lround(m.patch_area_mm2)))});
+             num(format_significant_digits(m.patch_area_mm2, 3))});
     }
   }
   if (r.supports.empty()) return;
@@ -171,7 +171,7 @@ void model_section(std::ostringstream& out, const RunFigures& r) {
     char radius[32];
     std::snprintf(radius, sizeof radius, "%g", s.radius_mm.value_or(0));
     t.row({text(markup_escape(s.name)), text(condition), text(s.center ? format_point(*s.center) : "n/a"),
-           num(s.radius_mm ? radius : "n/a"), num(format_count(std::lround(s.patch_area_mm2)))});
+           num(s.radius_mm ? radius : "n/a"), num(format_significant_digits(s.patch_area_mm2, 3))});
   }
 }
 
@@ -303,21 +303,23 @@ void probes_section(std::ostringstream& out, const RunFigures& r) {
     out << "<p>The scenario has no probes.</p>\n";
     return;
   }
-  Table t(out);
-  t.header({text("probe"), text("point (mm)"), text("displacement (mm)"), num("|u| (mm)"),
-            num("von Mises (MPa)"), num("moved (mm)")});
-  for (const ProbeFigures& p : r.coarse.probes) {
-    if (!p.found) {
-      t.row({text(markup_escape(p.name)), text(format_point(p.at)), text("not in the mesh"), num("n/a"),
-             num("n/a"), num(format_mm(p.moved_mm))});
-      continue;
+  {  // the table closed before the note: a <p> inside a <table> is invalid, and browsers move it above
+    Table t(out);
+    t.header({text("probe"), text("point (mm)"), text("displacement (mm)"), num("|u| (mm)"),
+              num("von Mises (MPa)"), num("moved (mm)")});
+    for (const ProbeFigures& p : r.coarse.probes) {
+      if (!p.found) {
+        t.row({text(markup_escape(p.name)), text(format_point(p.at)), text("not in the mesh"), num("n/a"),
+               num("n/a"), num(format_mm(p.moved_mm))});
+        continue;
+      }
+      char u[128];
+      std::snprintf(u, sizeof u, "(%s, %s, %s)", format_mm(p.displacement[0]).c_str(),
+                    format_mm(p.displacement[1]).c_str(), format_mm(p.displacement[2]).c_str());
+      t.row({text(markup_escape(p.name)), text(format_point(p.at)), text(u),
+             num(format_mm(vec3::norm(p.displacement))), num(format_mpa(p.von_mises)),
+             num(format_mm(p.moved_mm))});
     }
-    char u[128];
-    std::snprintf(u, sizeof u, "(%s, %s, %s)", format_mm(p.displacement[0]).c_str(),
-                  format_mm(p.displacement[1]).c_str(), format_mm(p.displacement[2]).c_str());
-    t.row({text(markup_escape(p.name)), text(format_point(p.at)), text(u),
-           num(format_mm(vec3::norm(p.displacement))), num(format_mpa(p.von_mises)),
-           num(format_mm(p.moved_mm))});
   }
   out << "<p class=\"note\">A probe outside the mesh is evaluated at the closest point just inside it; "
          "&ldquo;moved&rdquo; says how far.</p>\n";

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -11,6 +10,7 @@
 
 #include "common/error.h"
 #include "common/paths.h"
+#include "common/text_check.h"
 
 namespace hexbite::yaml_input {
 
@@ -58,14 +58,11 @@ std::string to_string(const Value& v, const std::string& hint) {
 
 std::string to_name(const Value& v, const std::string& hint) {
   const std::string name = to_string(v, hint);
-  for (const char c : name)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char code[8];
-      std::snprintf(code, sizeof code, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      fail(v.at, v.path + " holds a control character (" + code + (c == '\n' ? ", a line break" : "") +
-                     "); a name is one line of printable text: remove it (in YAML, '\\n' in double "
-                     "quotes is a line break)");
-    }
+  const std::string problem = control_character_problem(name);
+  if (!problem.empty())
+    fail(v.at, v.path + " " + problem +
+                   "; a name is one line of printable text: remove it (in YAML, '\\n' in double quotes is a "
+                   "line break)");
   return name;
 }
 

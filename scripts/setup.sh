@@ -8,7 +8,7 @@ packages=(
   libdeal.ii-dev libopenblas0-pthread
   libeigen3-dev libcgal-dev libvtk9-dev libgdcm-dev zlib1g-dev
   liblemon-dev libboost-graph-dev
-  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libutfcpp-dev libx11-dev libglx-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   calculix-ccx gmsh openmpi-bin
   xvfb xauth

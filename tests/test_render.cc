@@ -95,27 +95,36 @@ TEST(Render, SurfaceAndSolutionFieldPictures) {
   EXPECT_FALSE(fs::exists(dir + "/low.png"));
 }
 
-// Pixels of the picture's outermost rows and columns that are not background (white).
-int object_pixels_on_the_border(const std::string& png) {
+// Pixels of the object, neither background (white) nor text (grey: the legend's title reaches left of its
+// bar), in the part of the picture left of `share` of its width (the rest is the colour legend's): on the
+// outermost two rows and columns of that part, and in all of it.
+struct ObjectPixels {
+  int on_border = 0, all = 0;
+};
+ObjectPixels object_pixels(const std::string& png, double share = 1.0) {
   vtkNew<vtkPNGReader> reader;
   reader->SetFileName(png.c_str());
   reader->Update();
   vtkImageData* image = reader->GetOutput();
   int dims[3];
   image->GetDimensions(dims);
-  int count = 0;
+  const int width = static_cast<int>(share * dims[0]);
+  ObjectPixels count;
   for (int y = 0; y < dims[1]; ++y)
-    for (int x = 0; x < dims[0]; ++x) {
-      if (x > 1 && x < dims[0] - 2 && y > 1 && y < dims[1] - 2) continue;
-      double white = 0;
-      for (int c = 0; c < 3; ++c) white += image->GetScalarComponentAsDouble(x, y, 0, c);
-      if (white < 3 * 255 - 30) ++count;
+    for (int x = 0; x < width; ++x) {
+      double rgb[3];
+      for (int c = 0; c < 3; ++c) rgb[c] = image->GetScalarComponentAsDouble(x, y, 0, c);
+      if (rgb[0] + rgb[1] + rgb[2] >= 3 * 255 - 30 || (rgb[0] == rgb[1] && rgb[1] == rgb[2])) continue;
+      ++count.all;
+      if (x <= 1 || x >= width - 2 || y <= 1 || y >= dims[1] - 2) ++count.on_border;
     }
   return count;
 }
 
 // The whole object is in the picture: a tall box seen from the front in a landscape picture, and the jaw in
 // a portrait one, used to run off the top and bottom, or the sides (a fixed zoom after VTK's ResetCamera).
+// In a tall narrow picture (200 x 1200) the jaw was cut at both sides, or missing altogether, leaving the
+// legend alone (the zoom divided the view angle, which overshot at the wide angles such a shape needs).
 TEST(Render, TheWholeObjectIsInThePicture) {
   const std::string dir = temp_dir();
   test::write_file(dir + "/tall.obj",
@@ -124,18 +133,96 @@ TEST(Render, TheWholeObjectIsInThePicture) {
                    "f 3 8 7\nf 4 1 5\nf 4 5 8\n");
   ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/jaw.stl", "--voxel", "1.5"}).exit_code,
             0);
+  ASSERT_EQ(run_hexbite({"-q", "mesh", dir + "/jaw.stl", "--method", "grid", "--target-hexes", "300", "-o",
+                         dir + "/jaw.vtu"})
+                .exit_code,
+            0);
   struct Case {
     std::string input, options;
   };
-  for (const Case& c : {Case{"tall.obj", "--view front"}, Case{"tall.obj", "--view iso"},
-                        Case{"jaw.stl", "--view front --width 300 --height 600"},
-                        Case{"jaw.stl", "--view top --width 300 --height 600"}}) {
+  for (const Case& c :
+       {Case{"tall.obj", "--view front"}, Case{"tall.obj", "--view iso"},
+        Case{"jaw.stl", "--view front --width 300 --height 600"},
+        Case{"jaw.stl", "--view top --width 300 --height 600"},
+        Case{"jaw.stl", "--view top --width 200 --height 1200"}, Case{"jaw.stl", "--width 200 --height 1200"},
+        Case{"jaw.vtu", "--view top --width 200 --height 1200 --field scaled_jacobian"},
+        Case{"jaw.vtu", "--width 100 --height 2000 --field scaled_jacobian"},
+        Case{"jaw.stl", "--view side --width 2000 --height 64"}}) {
     ASSERT_EQ(run_with_prefix(display_prefix(),
                               "render '" + dir + "/" + c.input + "' -o '" + dir + "/p.png' " + c.options,
                               dir + "/log"),
               0)
         << read_file(dir + "/log");
-    EXPECT_EQ(object_pixels_on_the_border(dir + "/p.png"), 0) << c.input << " " << c.options;
+    // Left of the legend, which starts at 0.82 of the width, when there is one.
+    const ObjectPixels pixels =
+        object_pixels(dir + "/p.png", c.options.find("--field") != std::string::npos ? 0.82 : 1.0);
+    EXPECT_EQ(pixels.on_border, 0) << c.input << " " << c.options;
+    EXPECT_GT(pixels.all, 0) << c.input << " " << c.options;
+  }
+}
+
+// An array of several components is coloured by the one --component picks; without it only the
+// displacement is drawn (by its magnitude), and any other such array is refused naming its components and the
+// arrays of one. Before, `--field stress` was coloured by sqrt(xx^2 + yy^2 + zz^2 + xy^2 + yz^2 + xz^2),
+// which is no stress measure, and `--field principal_stress` by a norm that lost every sign.
+TEST(Render, AnArrayOfSeveralComponentsNeedsAComponent) {
+  const std::string dir = temp_dir(), vtu = dir + "/hex.vtu", png = dir + "/p.png";
+  test::write_file(
+      vtu,
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\">\n"
+      "<UnstructuredGrid><Piece NumberOfPoints=\"8\" NumberOfCells=\"1\">\n"
+      "<PointData><DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
+      "format=\"ascii\">"
+      "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1</DataArray>\n"
+      "<DataArray type=\"Float64\" Name=\"von_mises\" format=\"ascii\">1 2 3 4 5 6 7 "
+      "8</DataArray></PointData>\n"
+      "<CellData><DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">"
+      "-9 2 3 4 5 6</DataArray>\n"
+      "<DataArray type=\"Float64\" Name=\"principal_stress\" NumberOfComponents=\"3\" "
+      "ComponentName0=\"largest\" "
+      "ComponentName1=\"middle\" ComponentName2=\"smallest\" format=\"ascii\">12 -1 "
+      "-14</DataArray></CellData>\n"
+      "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
+      "0 0 0 10 0 0 10 10 0 0 10 0 0 0 10 10 0 10 10 10 10 0 10 10</DataArray></Points>\n"
+      "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 3 4 5 6 7</DataArray>\n"
+      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">8</DataArray>\n"
+      "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">12</DataArray></Cells>\n"
+      "</Piece></UnstructuredGrid></VTKFile>\n");
+  struct Case {
+    std::string options, fragment;
+  };
+  const std::vector<Case> refused = {
+      {"--field stress",
+       "'stress' in '" + vtu +
+           "' has 6 components (0, 1, 2, 3, 4, 5): pick one with --component N, or colour by an array of one "
+           "component: von_mises"},
+      {"--field principal_stress", "has 3 components (0 largest, 1 middle, 2 smallest): pick one"},
+      {"--field stress --component 6",
+       "--component 6 is not a component of 'stress' in '" + vtu + "', which has 6 (0, 1, 2, 3, 4, 5)"},
+      {"--field von_mises --component 0", "'von_mises' in '" + vtu + "' has one component: drop --component"},
+      {"--component 1", "--component picks a component of the array of --field, and no --field is given"},
+  };
+  for (const Case& c : refused) {
+    EXPECT_EQ(
+        run_with_prefix(display_prefix(), "render '" + vtu + "' -o '" + png + "' " + c.options, dir + "/log"),
+        2)
+        << c.options << "\n"
+        << read_file(dir + "/log");
+    EXPECT_NE(read_file(dir + "/log").find(c.fragment), std::string::npos) << read_file(dir + "/log");
+    EXPECT_FALSE(fs::exists(png)) << c.options;
+  }
+  for (const std::string options : {"--field stress --component 0", "--field principal_stress --component 2",
+                                    "--field displacement", "--field displacement --component 2"}) {
+    EXPECT_EQ(run_with_prefix(display_prefix(),
+                              "render '" + vtu + "' -o '" + png + "' --width 320 --height 200 " + options,
+                              dir + "/log"),
+              0)
+        << options << "\n"
+        << read_file(dir + "/log");
+    EXPECT_EQ(read_file(dir + "/log").find("ERR"), std::string::npos) << read_file(dir + "/log");
+    EXPECT_TRUE(fs::exists(png)) << options;
+    fs::remove(png);
   }
 }
 
@@ -161,10 +248,11 @@ TEST(Render, DamagedMeshIsOneCleanError) {
   EXPECT_FALSE(fs::exists(dir + "/cut.png"));
 }
 
-// Options that the input would ignore, a .vtu named in capitals and non-finite --max values: exit 2 before
-// anything is read or a display is needed. Before: `--field` on a surface and `--max` without `--field` were
-// silently ignored, `--max nan` too, `--max inf` was refused with a 309-digit bound, and `MESH.VTU` was read
-// as a surface ("unknown extension '.vtu'; accepted surface formats are .stl, ...").
+// Options that the input would ignore, a .vtu named in capitals, non-finite --max values and a --title
+// that is not one line of UTF-8: exit 2 before anything is read or a display is needed. Before: `--field` on
+// a surface and `--max` without `--field` were silently ignored, `--max nan` too, `--max inf` was refused
+// with a 309-digit bound, and `MESH.VTU` was read as a surface ("unknown extension '.vtu'; accepted surface
+// formats are .stl, ...").
 TEST(Render, OptionsTheInputIgnoresAreRefused) {
   const std::string dir = temp_dir();
   test::write_file(dir + "/cube.obj", test::cubes_obj(1));
@@ -198,6 +286,11 @@ TEST(Render, OptionsTheInputIgnoresAreRefused) {
       {{"render", dir + "/cube.obj", "--width", "abc", "-o", png},
        "--width: abc is not a number: give a whole number from 64 to 8,192"},
       {{"render", dir + "/cube.obj", "--height", "1e4", "-o", png}, "--height: 1e4 is out of range"},
+      // A caption VTK cannot draw: it was dropped from the picture, with VTK's errors, and exit 0.
+      {{"render", dir + "/cube.obj", "--title", "r\xe9sum\xe9", "-o", png},
+       "--title: the title is not valid UTF-8 (byte 0xE9 at position 2)"},
+      {{"render", dir + "/cube.obj", "--title", "a\x1b[1m", "-o", png},
+       "--title: the title holds a control character (0x1B)"},
   };
   for (const Case& c : cases) {
     const auto r = run_hexbite(c.args);
@@ -257,6 +350,30 @@ TEST(Render, WithoutDisplayFailsClearlyAndWritesNothing) {
             std::string::npos)
       << read_file(dir + "/log");
   EXPECT_FALSE(fs::exists(dir + "/jaw.png"));
+}
+
+// A display that answers but cannot give an OpenGL context: VTK aborted on it (exit 134, "Could not find a
+// decent config") without a word of hexbite's. Now it is refused as a display that does not answer is.
+TEST(Render, ADisplayWithoutOpenGlFailsClearlyAndWritesNothing) {
+  const std::string dir = temp_dir(), png = dir + "/cube.png";
+  test::write_file(dir + "/cube.obj", test::cubes_obj(1));
+  struct Case {
+    std::vector<std::string> options;
+    std::string fragment;
+  };
+  for (const Case& c : {Case{{"-extension", "GLX"}, "has no OpenGL: its X server lacks the GLX extension"},
+                        Case{{"-screen", "0", "640x480x8"}, "has no OpenGL: "}}) {
+    const test::VirtualDisplay x(c.options);
+    if (x.display().empty()) GTEST_SKIP() << "no X server for this test: " << x.problem();
+    EXPECT_EQ(run_with_prefix("env DISPLAY=" + x.display(), "render '" + dir + "/cube.obj' -o '" + png + "'",
+                              dir + "/log"),
+              1);
+    const std::string log = read_file(dir + "/log");
+    EXPECT_NE(log.find("no X display (the X display '" + x.display() + "' " + c.fragment), std::string::npos)
+        << log;
+    EXPECT_NE(log.find("); run the command under `xvfb-run -a`"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(png));
+  }
 }
 
 }  // namespace

@@ -171,12 +171,50 @@ TEST_F(Report, HoldsTheFiguresOfResultsJsonFormattedAsDocumented) {
   EXPECT_NE(quality.find(">" + printf_number("%.2f", q["oddy"]["min"].get<double>()) + "<"),
             std::string::npos)
       << quality;
-  EXPECT_NE(section(html, "Probes").find("<td>far_corner</td>"), std::string::npos);
+  const std::string probes = section(html, "Probes");
+  EXPECT_NE(probes.find("<td>far_corner</td>"), std::string::npos);
+  // The note follows the table: it was written inside it (before </table>), invalid HTML that browsers
+  // show above the table.
+  const std::size_t note = probes.find("<p class=\"note\">A probe outside the mesh");
+  ASSERT_NE(note, std::string::npos) << probes;
+  EXPECT_EQ(probes.rfind("</table>", note), note - 9) << probes;
   EXPECT_NE(section(html, "Pictures").find("no pictures"), std::string::npos);
 
   // The scenario's name escaped, in the title and the heading; never as markup.
   EXPECT_NE(html.find("<h1>cube &lt;b&gt;&amp; bite</h1>"), std::string::npos);
   EXPECT_EQ(html.find("<b>&"), std::string::npos);
+}
+
+// Patch areas and lengths with 3 significant digits, rounded before the form is chosen (reports.md, "How
+// figures are written"): a patch of 0.4 mm2 read "0" and one of 1.19 mm2 "1" (rounded to whole mm2), a
+// displacement of 12345.6 mm "12346", a strain energy of 10696.98 mJ "10697" and one of 999,999.7 mJ
+// "1000000".
+TEST_F(Report, AreasAndLargeFiguresHaveThreeSignificantDigits) {
+  const std::string dir = temp_dir();
+  json j = *results_;
+  j["supports"][0]["patch_area_mm2"] = 0.4;
+  j["muscles"][0]["patch_area_mm2"] = 1.1946187523303051;
+  for (json* level : {&j, &j["validation"]["levels"][0]}) {  // the coarse level, as the run writes it twice
+    (*level)["max_displacement_mm"] = 12345.6;
+    (*level)["strain_energy_mJ"] = 999999.7;
+  }
+  j["validation"]["levels"][1]["strain_energy_mJ"] = 10696.979;
+  write_file(dir + "/results.json", j.dump(1));
+  const test::CommandResult c = run_hexbite({"-q", "report", dir, "-o", dir + "/r.html", "--no-pictures"});
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const std::string html = read_file(dir + "/r.html");
+  const std::string model = section(html, "Model");
+  EXPECT_NE(model.find("<td>pull</td>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td class=\"n\">1.19</td></tr>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td>nut</td>"), std::string::npos) << model;
+  EXPECT_NE(model.find("<td class=\"n\">0.400</td></tr>"), std::string::npos) << model;
+  const std::string results = section(html, "Results");
+  EXPECT_NE(results.find("<td class=\"n\">12300</td>"), std::string::npos) << results;
+  EXPECT_NE(results.find("<td class=\"n\">1.00e+06</td>"), std::string::npos) << results;
+  const std::string validation = section(html, "Validation");
+  EXPECT_NE(validation.find("<td class=\"n\">10700</td>"), std::string::npos) << validation;
+  EXPECT_EQ(html.find("1000000"), std::string::npos);
+  EXPECT_EQ(html.find("12346"), std::string::npos);
 }
 
 TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
@@ -238,6 +276,26 @@ TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
       std::string::npos)
       << bad.err;
   EXPECT_FALSE(fs::exists(dir + "/bad.html"));
+}
+
+// A display that answers but has no OpenGL (an X server without GLX, as many ssh -X and VNC servers are):
+// VTK aborted (exit 134) and left the pictures' temporary folder behind.
+TEST_F(Report, ADisplayWithoutOpenGlIsRefusedAndLeavesNothing) {
+  const test::VirtualDisplay x({"-extension", "GLX"});
+  if (x.display().empty()) GTEST_SKIP() << "no X server for this test: " << x.problem();
+  const std::string dir = temp_dir(), tmp = dir + "/tmp";
+  fs::create_directories(tmp);
+  const test::CommandResult r = run_hexbite({"-q", "report", *run_dir_, "-o", dir + "/r.html"},
+                                            {"env", "DISPLAY=" + x.display(), "TMPDIR=" + tmp});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot draw the report's pictures: no X display (the X display '" + x.display() +
+                       "' has no OpenGL: its X server lacks the GLX extension"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("run the command under `xvfb-run -a`, or add --no-pictures"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/r.html"));
+  EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
 }
 
 // A TMPDIR that filled up while the pictures were drawn there was blamed on the report's folder ("make room
@@ -498,6 +556,21 @@ TEST_F(Report, ValuesNoRunWritesAndABlankTitleAreRefused) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find("--title"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("the title is blank"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // A Latin-1 title made the report invalid UTF-8 (it declares utf-8), a control character invalid HTML.
+  const std::vector<std::pair<std::string, std::string>> titles = {
+      {"r\xe9sum\xe9", "--title: the title is not valid UTF-8 (byte 0xE9 at position 2): give it in UTF-8"},
+      {"a\x01"
+       "b",
+       "--title: the title holds a control character (0x01); it is one line of printable text: remove it"},
+      {"two\nlines", "--title: the title holds a control character (0x0A, a line break)"},
+  };
+  for (const auto& [title, message] : titles) {
+    const test::CommandResult r =
+        run_hexbite({"report", *run_dir_, "-o", out, "--no-pictures", "--title", title});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
 }

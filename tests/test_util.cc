@@ -1,5 +1,6 @@
 #include "tests/test_util.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -60,6 +61,49 @@ std::string temp_dir() {
   fs::path dir = root.path / std::to_string(counter++);
   fs::create_directories(dir);
   return dir.string();
+}
+
+VirtualDisplay::VirtualDisplay(const std::vector<std::string>& options) {
+  int ready[2];
+  if (::pipe(ready) != 0) {
+    problem_ = "no pipe for Xvfb";
+    return;
+  }
+  std::vector<std::string> args = {"Xvfb", "-displayfd", std::to_string(ready[1]), "-nolisten", "tcp"};
+  args.insert(args.end(), options.begin(), options.end());
+  pid_ = ::fork();
+  if (pid_ == 0) {
+    ::close(ready[0]);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execvp(argv[0], argv.data());
+    ::_exit(127);
+  }
+  ::close(ready[1]);
+  // Xvfb writes the display number when it is ready; the pipe ends without one when it stops (or is missing).
+  std::string number;
+  char c = 0;
+  while (pid_ > 0 && ::read(ready[0], &c, 1) == 1 && c != '\n') number += c;
+  ::close(ready[0]);
+  if (!number.empty()) {
+    display_ = ":" + number;
+    return;
+  }
+  int status = 0;
+  if (pid_ > 0) ::waitpid(pid_, &status, 0);
+  pid_ = -1;
+  problem_ = WIFEXITED(status) && WEXITSTATUS(status) == 127 ? "Xvfb is not installed"
+                                                             : "Xvfb stopped without opening a display";
+}
+
+VirtualDisplay::~VirtualDisplay() {
+  if (pid_ <= 0) return;
+  ::kill(pid_, SIGTERM);
+  ::waitpid(pid_, nullptr, 0);
 }
 
 CommandResult run_hexbite(const std::vector<std::string>& args, const std::vector<std::string>& launcher) {

@@ -54,6 +54,23 @@ class FileSizeLimit {
   unsigned long long soft_ = 0;
 };
 
+// An X server of its own (Xvfb) on a free display number (Xvfb -displayfd picks it), started with
+// `options` (e.g. {"-extension", "GLX"}) and stopped when this ends. display() is ":N", or empty when none
+// could be started, and problem() then says why (no Xvfb installed, or it stopped at once).
+class VirtualDisplay {
+ public:
+  explicit VirtualDisplay(const std::vector<std::string>& options);
+  ~VirtualDisplay();
+  VirtualDisplay(const VirtualDisplay&) = delete;
+  VirtualDisplay& operator=(const VirtualDisplay&) = delete;
+  const std::string& display() const { return display_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  int pid_ = -1;
+  std::string display_, problem_;
+};
+
 // The message of the exception of type E that f() throws; a test failure, and "", when it throws none.
 template <class E, class F>
 std::string message_of(F f) {
