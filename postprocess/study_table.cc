@@ -169,21 +169,30 @@ json study_json(const StudyTable& table) {
                         {"reactions", reactions},
                         {"released", row.released}});
   }
-  for (json& v : variants) {
-    const json& reference = variants.front();
+  json study = {
+      {"study", table.study}, {"study_file", table.study_file}, {"base", table.base}, {"variants", variants}};
+  // Every row holds every support of any variant, null where the variant has none, as the CSV's columns do:
+  // a support renamed by the study was left out of the other variants' rows, where scripts read it.
+  const std::vector<std::string> supports = support_names(study);
+  for (json& v : study["variants"]) {
+    json reactions = json::object();
+    for (const std::string& s : supports) reactions[s] = reaction(v, s);
+    v["reactions"] = reactions;
+  }
+  for (json& v : study["variants"]) {
+    const json& reference = study["variants"].front();
     json change = json::object();
     for (const Figure& f : kFigures) change[f.key] = relative(v[f.key], reference[f.key]);
     json reactions = json::object();
     // A released contact's 0 is not a measured reaction: no relative change to or from it.
-    for (const auto& [name, magnitude] : v["reactions"].items())
-      reactions[name] = released(v, name) || released(reference, name)
-                            ? json()
-                            : relative(magnitude, reaction(reference, name));
+    for (const std::string& s : supports)
+      reactions[s] = released(v, s) || released(reference, s)
+                         ? json()
+                         : relative(reaction(v, s), reaction(reference, s));
     change["reactions"] = reactions;
     v["relative_to_reference"] = change;
   }
-  return {
-      {"study", table.study}, {"study_file", table.study_file}, {"base", table.base}, {"variants", variants}};
+  return study;
 }
 
 std::string study_csv(const json& study) {

@@ -468,6 +468,29 @@ TEST(StudyTable, AChangeWithoutAReferenceFigureIsADash) {
       << md;
 }
 
+// studies.md promises null for the reaction of a support that only some variants have (a support renamed by
+// the study): study.json left the key out of the other variants' rows, while the CSV and study.md had its
+// column, so a script reading it as documented failed with a KeyError.
+TEST(StudyTable, ASupportOfOnlySomeVariantsIsNullInTheOthersRows) {
+  StudyTable table;
+  for (const std::string& name : {"reference", "renamed"}) {
+    StudyRow row;
+    row.name = name;
+    row.set = nlohmann::ordered_json::object();
+    row.reactions = {{name == "reference" ? "nut" : "bite", 361.5}, {"condyle", 220.0}};
+    table.rows.push_back(row);
+  }
+  const nlohmann::ordered_json study = study_json(table);
+  EXPECT_EQ(study["variants"][0]["reactions"],
+            nlohmann::ordered_json({{"nut", 361.5}, {"condyle", 220.0}, {"bite", nullptr}}));
+  EXPECT_EQ(study["variants"][1]["reactions"],
+            nlohmann::ordered_json({{"nut", nullptr}, {"condyle", 220.0}, {"bite", 361.5}}));
+  EXPECT_EQ(study["variants"][1]["relative_to_reference"]["reactions"],
+            nlohmann::ordered_json({{"nut", nullptr}, {"condyle", 0.0}, {"bite", nullptr}}));
+  EXPECT_EQ(study["variants"][0]["relative_to_reference"]["reactions"],
+            nlohmann::ordered_json({{"nut", 0.0}, {"condyle", 0.0}, {"bite", nullptr}}));
+}
+
 // A backtick in a set value ended study.md's code span: the span is fenced by more backticks than it holds.
 TEST(StudyTable, ABacktickInAChangeStaysInItsCodeSpan) {
   StudyTable table;
