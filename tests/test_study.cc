@@ -531,6 +531,13 @@ TEST(Study, InvalidOverriddenValueIsNamedAtTheStudysLine) {
                  "variant 'soft': materials.default.E_MPa is -5 MPa but Young's modulus must be positive");
 }
 
+// `mesh.core: ~` (a try to drop the base's core) was told "write a word such as left_condyle".
+TEST(Study, AChoiceTheStudySetToNothingGetsTheValidChoices) {
+  expect_refused(soft_setting("mesh.core: ~"), 7,
+                 "variant 'soft': mesh.core must be text, found nothing; valid choices are 'grid', 'swept', "
+                 "'auto'");
+}
+
 // An empty list the study set is named at the study's line (it was named at the base's `supports:` key).
 TEST(Study, AnEmptyListTheStudySetIsNamedAtTheStudysLine) {
   expect_refused(soft_setting("supports: []"), 7, "the scenario has no supports");
