@@ -8,6 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/error.h"
 #include "common/number_format.h"
 
 namespace hexbite {
@@ -140,14 +141,20 @@ std::string study_changes(const json& set, bool abbreviate) {
   for (const auto& [path, value] : set.items()) {
     std::string text = value.is_string() ? value.get<std::string>() : yaml_flow(value);
     if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
-    // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell.
+    // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell. A
+    // tab and a Unicode line or paragraph separator are spaces too.
+    for (const char* separator : {"\u2028", "\u2029"})
+      for (std::size_t at = text.find(separator); at != std::string::npos; at = text.find(separator, at))
+        text.replace(at, 3, " ");
     std::string line;
     for (char c : text) {
-      if (c == '\n' || c == '\r') c = ' ';
+      if (c == '\n' || c == '\r' || c == '\t') c = ' ';
       if (c != ' ' || (!line.empty() && line.back() != ' ')) line += c;
     }
     while (!line.empty() && line.back() == ' ') line.pop_back();
-    out += (out.empty() ? "" : "; ") + path + ": " + line;
+    // Any other control character (a scenario's description may hold ESC or NUL) went raw into the tables
+    // and onto the terminal, where "\x1b[2J" cleared the screen: written \xNN, as in messages.
+    out += (out.empty() ? "" : "; ") + path + ": " + printable_message(line);
   }
   return out;
 }

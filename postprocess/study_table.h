@@ -36,8 +36,9 @@ struct StudyTable {
   std::vector<StudyRow> rows;  // the first is the reference
 };
 
-// A variant's changes on one line: "path: value; path: value". With `abbreviate` (Markdown), a mapping or
-// list longer than a table cell stands as "{...}" or "[...]": study.csv and study.json give it whole.
+// A variant's changes on one line: "path: value; path: value", line breaks and tabs as spaces, other
+// control characters as \xNN. With `abbreviate` (Markdown), a mapping or list longer than a table cell stands
+// as "{...}" or "[...]": study.csv and study.json give it whole.
 std::string study_changes(const nlohmann::ordered_json& set, bool abbreviate);
 
 // {study, study_file, base, variants: [{name, set, level, hexes, bite_force_N, max_displacement_mm,

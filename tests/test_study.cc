@@ -491,6 +491,31 @@ TEST(StudyTable, ASupportOfOnlySomeVariantsIsNullInTheOthersRows) {
             nlohmann::ordered_json({{"nut", 0.0}, {"condyle", 0.0}, {"bite", nullptr}}));
 }
 
+// A control character of a value the study set (description: "a\tb\x1b[2Jc\x00d", which a scenario takes)
+// went raw into study.csv, study.md and the table on the terminal: ESC[2J cleared the terminal, and a NUL
+// made the tables binary files. A tab or a line separator is a space, as a line break is; the others are
+// written as \xNN, as in messages. study.json keeps the value exactly.
+TEST(StudyTable, AControlCharacterInAChangeIsWrittenVisibly) {
+  StudyTable table;
+  StudyRow row;
+  row.name = "v";
+  const char description[] = "a\tb\x1b[2Jc\0d\x7f e\u2028f\u2029";  // with a NUL
+  row.set = {{"description", std::string(description, sizeof description - 1)}};
+  table.rows.push_back(row);
+  const nlohmann::ordered_json study = study_json(table);
+  EXPECT_EQ(study["variants"][0]["set"], row.set);
+  const std::string line = "description: a b\\x1b[2Jc\\x00d\\x7f e f";
+  EXPECT_EQ(study_changes(row.set, false), line);
+  const std::string csv = study_csv(study);
+  const std::string md = study_markdown(study);
+  EXPECT_NE(csv.find("," + line + ","), std::string::npos) << csv;
+  EXPECT_NE(md.find("| `" + line + "` |"), std::string::npos) << md;
+  for (const std::string& text : {csv, md})
+    EXPECT_TRUE(std::none_of(text.begin(), text.end(), [](char c) {
+      return c != '\n' && (static_cast<unsigned char>(c) < 0x20 || c == 0x7f);
+    })) << text;
+}
+
 // A backtick in a set value ended study.md's code span: the span is fenced by more backticks than it holds.
 TEST(StudyTable, ABacktickInAChangeStaysInItsCodeSpan) {
   StudyTable table;
