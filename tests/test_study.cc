@@ -808,6 +808,30 @@ TEST(Study, AFileWhereAVariantsFolderGoesIsRefusedAtTheVariantsLine) {
   }
 }
 
+// A symbolic link where a variant's folder goes (a variant's folder linked to another disk) was called "a
+// file, not a folder" and the user was told to remove "the file": the message says it is a link, and where it
+// points or that its target does not exist.
+TEST(Study, ALinkWhereAVariantsFolderGoesIsNamedALink) {
+  std::string study = kStudy;
+  study.resize(study.find("  - name: soft"));
+  for (const std::string& target : {std::string("../elsewhere"), std::string("../nowhere")}) {
+    const std::string dir = study_folder(study);
+    fs::create_directories(dir + "/out");
+    fs::create_directories(dir + "/elsewhere");
+    fs::create_directory_symlink(target, dir + "/out/reference");
+    const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(r.err, "hexbite: error: " + dir + "/study.yaml:4:5: variant 'reference': its run folder '" +
+                         dir + "/out/reference' is a symbolic link to '" + target + "'" +
+                         (target == "../nowhere" ? ", which does not exist or loops" : "") +
+                         ", not a folder; a variant's run folder must be a real folder: rename the variant "
+                         "(its name names the folder), remove or rename the link, or choose another output "
+                         "folder\n");
+    EXPECT_TRUE(fs::is_symlink(dir + "/out/reference"));
+    EXPECT_TRUE(fs::is_empty(dir + "/elsewhere"));
+  }
+}
+
 // Into a file or a pipe, the lines that announce the variants waited in the buffer until something else
 // flushed it (the first solve) or the study ended, and a kill (a batch system's time limit) lost them. The
 // study is stopped as soon as its first line is in the file: while the variants are checked, not after.
