@@ -118,15 +118,21 @@ void run_study(const StudyCliOptions& o) {
   }
   // A file where a variant's folder goes (a variant named notes.txt beside your notes) was found only when
   // the study was moved into DIR, after every variant had solved. The rule of the stage's commit: anything
-  // but a folder is in the way, a link too.
+  // but a folder is in the way, a link too; a link (to a folder on another disk) was called "a file".
   for (const StudyVariant& v : study.variants) {
     const fs::path folder = fs::path(o.output) / v.name;
     std::error_code ec;
     const fs::file_status status = fs::symlink_status(folder, ec);
-    if (fs::exists(status) && !fs::is_directory(status))
-      throw InputError(v.where.str() + ": variant '" + v.name + "': its run folder '" + folder.string() +
-                       "' is a file, not a folder; rename the variant (its name names the folder), remove or "
-                       "rename the file, or choose another output folder");
+    if (!fs::exists(status) || fs::is_directory(status)) continue;
+    const bool link = fs::is_symlink(status);
+    const std::string what = link ? "a symbolic link to '" + fs::read_symlink(folder, ec).string() + "'" +
+                                        (fs::exists(folder, ec) ? "" : ", which does not exist or loops") +
+                                        ", not a folder; a variant's run folder must be a real folder:"
+                                  : "a file, not a folder;";
+    throw InputError(v.where.str() + ": variant '" + v.name + "': its run folder '" + folder.string() +
+                     "' is " + what +
+                     " rename the variant (its name names the folder), remove or rename the " +
+                     (link ? "link" : "file") + ", or choose another output folder");
   }
   const auto counted = [&](std::size_t i) {
     return std::to_string(i + 1) + " / " + std::to_string(count) + ": " + study.variants[i].name;

@@ -8,6 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/error.h"
 #include "common/number_format.h"
 
 namespace hexbite {
@@ -140,14 +141,20 @@ std::string study_changes(const json& set, bool abbreviate) {
   for (const auto& [path, value] : set.items()) {
     std::string text = value.is_string() ? value.get<std::string>() : yaml_flow(value);
     if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
-    // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell.
+    // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell. A
+    // tab and a Unicode line or paragraph separator are spaces too.
+    for (const char* separator : {"\u2028", "\u2029"})
+      for (std::size_t at = text.find(separator); at != std::string::npos; at = text.find(separator, at))
+        text.replace(at, 3, " ");
     std::string line;
     for (char c : text) {
-      if (c == '\n' || c == '\r') c = ' ';
+      if (c == '\n' || c == '\r' || c == '\t') c = ' ';
       if (c != ' ' || (!line.empty() && line.back() != ' ')) line += c;
     }
     while (!line.empty() && line.back() == ' ') line.pop_back();
-    out += (out.empty() ? "" : "; ") + path + ": " + line;
+    // Any other control character (a scenario's description may hold ESC or NUL) went raw into the tables
+    // and onto the terminal, where "\x1b[2J" cleared the screen: written \xNN, as in messages.
+    out += (out.empty() ? "" : "; ") + path + ": " + printable_message(line);
   }
   return out;
 }
@@ -169,21 +176,30 @@ json study_json(const StudyTable& table) {
                         {"reactions", reactions},
                         {"released", row.released}});
   }
-  for (json& v : variants) {
-    const json& reference = variants.front();
+  json study = {
+      {"study", table.study}, {"study_file", table.study_file}, {"base", table.base}, {"variants", variants}};
+  // Every row holds every support of any variant, null where the variant has none, as the CSV's columns do:
+  // a support renamed by the study was left out of the other variants' rows, where scripts read it.
+  const std::vector<std::string> supports = support_names(study);
+  for (json& v : study["variants"]) {
+    json reactions = json::object();
+    for (const std::string& s : supports) reactions[s] = reaction(v, s);
+    v["reactions"] = reactions;
+  }
+  for (json& v : study["variants"]) {
+    const json& reference = study["variants"].front();
     json change = json::object();
     for (const Figure& f : kFigures) change[f.key] = relative(v[f.key], reference[f.key]);
     json reactions = json::object();
     // A released contact's 0 is not a measured reaction: no relative change to or from it.
-    for (const auto& [name, magnitude] : v["reactions"].items())
-      reactions[name] = released(v, name) || released(reference, name)
-                            ? json()
-                            : relative(magnitude, reaction(reference, name));
+    for (const std::string& s : supports)
+      reactions[s] = released(v, s) || released(reference, s)
+                         ? json()
+                         : relative(reaction(v, s), reaction(reference, s));
     change["reactions"] = reactions;
     v["relative_to_reference"] = change;
   }
-  return {
-      {"study", table.study}, {"study_file", table.study_file}, {"base", table.base}, {"variants", variants}};
+  return study;
 }
 
 std::string study_csv(const json& study) {

@@ -36,13 +36,14 @@ struct StudyTable {
   std::vector<StudyRow> rows;  // the first is the reference
 };
 
-// A variant's changes on one line: "path: value; path: value". With `abbreviate` (Markdown), a mapping or
-// list longer than a table cell stands as "{...}" or "[...]": study.csv and study.json give it whole.
+// A variant's changes on one line: "path: value; path: value", line breaks and tabs as spaces, other
+// control characters as \xNN. With `abbreviate` (Markdown), a mapping or list longer than a table cell stands
+// as "{...}" or "[...]": study.csv and study.json give it whole.
 std::string study_changes(const nlohmann::ordered_json& set, bool abbreviate);
 
 // {study, study_file, base, variants: [{name, set, level, hexes, bite_force_N, max_displacement_mm,
-// von_mises_max_MPa, von_mises_p99_MPa, strain_energy_mJ, reactions {support: N}, released [contacts],
-// relative_to_reference
+// von_mises_max_MPa, von_mises_p99_MPa, strain_energy_mJ, reactions {support: N} (every support of any
+// variant, null where the variant has none), released [contacts], relative_to_reference
 // {the same figures and reactions as (variant - reference) / |reference|}}]}; a relative change is null
 // where either figure is missing or the reference's is zero.
 nlohmann::ordered_json study_json(const StudyTable& table);

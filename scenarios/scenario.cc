@@ -144,7 +144,8 @@ template <typename Enum>
 Enum to_choice(const Value& v, const std::vector<std::pair<std::string, Enum>>& choices) {
   std::vector<std::string> names;
   for (const auto& [name, value] : choices) names.push_back(name);
-  const std::string given = to_string(v);
+  // Nothing, a list or a mapping was told "write a word such as left_condyle", to_string's hint for points.
+  const std::string given = to_string(v, "valid choices are " + join_quoted(names));
   for (const auto& [name, value] : choices)
     if (given == name) return value;
   fail(v.at, v.path + " is " + quote(given) + ", not a valid choice; " + suggestion(given, names));

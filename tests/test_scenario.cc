@@ -361,6 +361,22 @@ TEST(ScenarioErrors, UnknownKeySuggestsTheClosest) {
                   "did you mean 'dentate'?");
 }
 
+// A choice given nothing, a list or a mapping (mesh.core: ~, a study's first try to drop the base's core)
+// was told "write a word such as left_condyle", the hint for point names; it gets the valid choices, as a
+// wrong word does.
+TEST(ScenarioErrors, AChoiceThatIsNoWordGetsTheValidChoices) {
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {core: ~}\n"), 11,
+                  "mesh.core must be text, found nothing; valid choices are 'grid', 'swept', 'auto'");
+  EXPECT_ERROR_AT(error_of(kValid + "solver: {linear_solver: [direct]}\n"), 11,
+                  "solver.linear_solver must be text, found a list; valid choices are 'auto', 'cg_amg', "
+                  "'direct'");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "variant: dentate", "variant: {a: b}")), 3,
+                  "geometry.mandible.variant must be text, found a mapping; valid choices are 'dentate', "
+                  "'edentulous', 'atrophic'");
+  EXPECT_ERROR_AT(error_of(kValid + "mesh: {method: \"\"}\n"), 11,
+                  "mesh.method is empty; valid choices are 'grid', 'sheets'");
+}
+
 // A name is one line of printable text: "incisal\n*HEADING" split model.inp's comment line, and the rest of
 // the name became a CalculiX keyword line.
 TEST(ScenarioErrors, NamesWithControlCharactersAreRefusedAtTheirLine) {

@@ -468,6 +468,54 @@ TEST(StudyTable, AChangeWithoutAReferenceFigureIsADash) {
       << md;
 }
 
+// studies.md promises null for the reaction of a support that only some variants have (a support renamed by
+// the study): study.json left the key out of the other variants' rows, while the CSV and study.md had its
+// column, so a script reading it as documented failed with a KeyError.
+TEST(StudyTable, ASupportOfOnlySomeVariantsIsNullInTheOthersRows) {
+  StudyTable table;
+  for (const std::string& name : {"reference", "renamed"}) {
+    StudyRow row;
+    row.name = name;
+    row.set = nlohmann::ordered_json::object();
+    row.reactions = {{name == "reference" ? "nut" : "bite", 361.5}, {"condyle", 220.0}};
+    table.rows.push_back(row);
+  }
+  const nlohmann::ordered_json study = study_json(table);
+  EXPECT_EQ(study["variants"][0]["reactions"],
+            nlohmann::ordered_json({{"nut", 361.5}, {"condyle", 220.0}, {"bite", nullptr}}));
+  EXPECT_EQ(study["variants"][1]["reactions"],
+            nlohmann::ordered_json({{"nut", nullptr}, {"condyle", 220.0}, {"bite", 361.5}}));
+  EXPECT_EQ(study["variants"][1]["relative_to_reference"]["reactions"],
+            nlohmann::ordered_json({{"nut", nullptr}, {"condyle", 0.0}, {"bite", nullptr}}));
+  EXPECT_EQ(study["variants"][0]["relative_to_reference"]["reactions"],
+            nlohmann::ordered_json({{"nut", 0.0}, {"condyle", 0.0}, {"bite", nullptr}}));
+}
+
+// A control character of a value the study set (description: "a\tb\x1b[2Jc\x00d", which a scenario takes)
+// went raw into study.csv, study.md and the table on the terminal: ESC[2J cleared the terminal, and a NUL
+// made the tables binary files. A tab or a line separator is a space, as a line break is; the others are
+// written as \xNN, as in messages. study.json keeps the value exactly.
+TEST(StudyTable, AControlCharacterInAChangeIsWrittenVisibly) {
+  StudyTable table;
+  StudyRow row;
+  row.name = "v";
+  const char description[] = "a\tb\x1b[2Jc\0d\x7f e\u2028f\u2029";  // with a NUL
+  row.set = {{"description", std::string(description, sizeof description - 1)}};
+  table.rows.push_back(row);
+  const nlohmann::ordered_json study = study_json(table);
+  EXPECT_EQ(study["variants"][0]["set"], row.set);
+  const std::string line = "description: a b\\x1b[2Jc\\x00d\\x7f e f";
+  EXPECT_EQ(study_changes(row.set, false), line);
+  const std::string csv = study_csv(study);
+  const std::string md = study_markdown(study);
+  EXPECT_NE(csv.find("," + line + ","), std::string::npos) << csv;
+  EXPECT_NE(md.find("| `" + line + "` |"), std::string::npos) << md;
+  for (const std::string& text : {csv, md})
+    EXPECT_TRUE(std::none_of(text.begin(), text.end(), [](char c) {
+      return c != '\n' && (static_cast<unsigned char>(c) < 0x20 || c == 0x7f);
+    })) << text;
+}
+
 // A backtick in a set value ended study.md's code span: the span is fenced by more backticks than it holds.
 TEST(StudyTable, ABacktickInAChangeStaysInItsCodeSpan) {
   StudyTable table;
@@ -506,6 +554,13 @@ TEST(Study, DuplicateVariantNameIsRefused) {
 TEST(Study, InvalidOverriddenValueIsNamedAtTheStudysLine) {
   expect_refused(soft_setting("materials.default.E_MPa: -5"), 7,
                  "variant 'soft': materials.default.E_MPa is -5 MPa but Young's modulus must be positive");
+}
+
+// `mesh.core: ~` (a try to drop the base's core) was told "write a word such as left_condyle".
+TEST(Study, AChoiceTheStudySetToNothingGetsTheValidChoices) {
+  expect_refused(soft_setting("mesh.core: ~"), 7,
+                 "variant 'soft': mesh.core must be text, found nothing; valid choices are 'grid', 'swept', "
+                 "'auto'");
 }
 
 // An empty list the study set is named at the study's line (it was named at the base's `supports:` key).
@@ -750,6 +805,30 @@ TEST(Study, AFileWhereAVariantsFolderGoesIsRefusedAtTheVariantsLine) {
                   "rename the file, or choose another output folder\n");
     EXPECT_EQ(r.out.find("variant 1"), std::string::npos) << r.out;
     test::expect_same_files(before, test::files_under(out));
+  }
+}
+
+// A symbolic link where a variant's folder goes (a variant's folder linked to another disk) was called "a
+// file, not a folder" and the user was told to remove "the file": the message says it is a link, and where it
+// points or that its target does not exist.
+TEST(Study, ALinkWhereAVariantsFolderGoesIsNamedALink) {
+  std::string study = kStudy;
+  study.resize(study.find("  - name: soft"));
+  for (const std::string& target : {std::string("../elsewhere"), std::string("../nowhere")}) {
+    const std::string dir = study_folder(study);
+    fs::create_directories(dir + "/out");
+    fs::create_directories(dir + "/elsewhere");
+    fs::create_directory_symlink(target, dir + "/out/reference");
+    const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(r.err, "hexbite: error: " + dir + "/study.yaml:4:5: variant 'reference': its run folder '" +
+                         dir + "/out/reference' is a symbolic link to '" + target + "'" +
+                         (target == "../nowhere" ? ", which does not exist or loops" : "") +
+                         ", not a folder; a variant's run folder must be a real folder: rename the variant "
+                         "(its name names the folder), remove or rename the link, or choose another output "
+                         "folder\n");
+    EXPECT_TRUE(fs::is_symlink(dir + "/out/reference"));
+    EXPECT_TRUE(fs::is_empty(dir + "/elsewhere"));
   }
 }
 
