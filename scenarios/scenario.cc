@@ -177,10 +177,11 @@ double patch_radius(const Value& v, const std::string& unit_hint) {
   return r;
 }
 
-// With `folder_too`, a folder is taken as well (a CT volume given as a DICOM series).
+// With `folder_too`, a folder is taken as well (a CT volume given as a DICOM series). `example` (a file name)
+// is the hint for a value that is no text.
 std::string resolve_file(const Source& ctx, const Value& v, const std::string& kind,
-                         bool folder_too = false) {
-  const std::string given = to_string(v);
+                         const std::string& example, bool folder_too = false) {
+  const std::string given = to_string(v, "give the " + kind + " file's path, e.g. file: " + example);
   fs::path path(given);
   // A path that a study set resolves against the study file's folder (yaml_input.h).
   const fs::path folder = ctx.folder_of(v.node);
@@ -254,15 +255,16 @@ GeometrySpec parse_geometry(const Source& ctx, const Value& v) {
   } else if (map.has("surface")) {
     g.source = GeometrySource::kSurface;
     const Map s(map.get("surface"), {"file", "units"});
-    g.file = resolve_file(ctx, s.require("file", "file: jaw.stl"), "surface");
+    g.file = resolve_file(ctx, s.require("file", "file: jaw.stl"), "surface", "jaw.stl");
     read_units(s, g);
   } else {
     g.source = GeometrySource::kCt;
     const Map c(map.get("ct"), {"file", "threshold", "series", "units"});
-    g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume", true);
+    g.file = resolve_file(ctx, c.require("file", "file: jaw.mha"), "CT volume", "jaw.mha", true);
     g.threshold =
         to_number(c.require("threshold", "threshold: 400 (the bone iso-value, e.g. in Hounsfield units)"));
-    if (auto series = c.find("series")) g.dicom_series = to_string(*series);
+    if (auto series = c.find("series"))
+      g.dicom_series = to_string(*series, "give the series' number, description or UID, e.g. series: 3");
     read_units(c, g);
   }
   return g;
@@ -277,7 +279,7 @@ LandmarkSpec parse_landmarks(const Source& ctx, const std::optional<Value>& v, c
   if (!v) return l;
   const Map map(*v, {"file", "units", "points"});
   l.where = v->at;
-  if (auto x = map.find("file")) l.file = resolve_file(ctx, *x, "landmark");
+  if (auto x = map.find("file")) l.file = resolve_file(ctx, *x, "landmark", "landmarks.yaml");
   if (auto x = map.find("units")) {
     if (!map.has("file"))
       fail(map.key_at("units"),

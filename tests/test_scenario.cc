@@ -377,6 +377,19 @@ TEST(ScenarioErrors, AChoiceThatIsNoWordGetsTheValidChoices) {
                   "mesh.method is empty; valid choices are 'grid', 'sheets'");
 }
 
+// A file or a DICOM series given nothing or a list was told to "write a word such as left_condyle" too.
+TEST(ScenarioErrors, AFileThatIsNoTextAsksForTheFilesPath) {
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "mandible: {variant: dentate}", "surface: {file: ~}")), 3,
+      "geometry.surface.file must be text, found nothing; give the surface file's path, e.g. file: "
+      "jaw.stl");
+  EXPECT_ERROR_AT(
+      error_of(replace(kValid, "mandible: {variant: dentate}", "ct: {file: [a], threshold: 400}")), 3,
+      "found a list; give the CT volume file's path, e.g. file: jaw.mha");
+  EXPECT_ERROR_AT(error_of(kValid + "landmarks: {file: ~}\n"), 11,
+                  "found nothing; give the landmark file's path, e.g. file: landmarks.yaml");
+}
+
 // A name is one line of printable text: "incisal\n*HEADING" split model.inp's comment line, and the rest of
 // the name became a CalculiX keyword line.
 TEST(ScenarioErrors, NamesWithControlCharactersAreRefusedAtTheirLine) {
