@@ -230,11 +230,15 @@ int checked_stdout(int exit_code) {
 // spinning (600 MB on this 2-core machine: `hexbite --version` printed and never ended; a 64-core node's
 // buffers alone take 8 GB). OpenBLAS reads its thread count from OPENBLAS_NUM_THREADS when it is loaded,
 // before main, so under such a limit, unless the user chose a count, hexbite starts itself again with one
-// BLAS thread. Its BLAS work is small (MUMPS factorizes at most 30,000 unknowns unless asked to).
+// BLAS thread. Its BLAS work is small (MUMPS factorizes at most 30,000 unknowns unless asked to). OpenBLAS
+// takes a value that atoi() does not read as positive (empty, 0, "abc": a script's unset
+// $SLURM_CPUS_PER_TASK) as no choice and falls back to OMP_NUM_THREADS or a thread per core, so such a value
+// is no choice here either.
 void one_blas_thread_under_an_address_space_limit(char** argv) {
   rlimit address_space{};
   if (getrlimit(RLIMIT_AS, &address_space) != 0 || address_space.rlim_cur == RLIM_INFINITY) return;
-  if (std::getenv("OPENBLAS_NUM_THREADS") != nullptr) return;
+  const char* chosen = std::getenv("OPENBLAS_NUM_THREADS");
+  if (chosen != nullptr && std::atoi(chosen) > 0) return;
   setenv("OPENBLAS_NUM_THREADS", "1", 1);
   execv("/proc/self/exe", argv);  // returns only when it failed: go on as before
 }

@@ -270,6 +270,13 @@ TEST(Cli, UnderATightAddressSpaceLimitCommandsEndAndOutOfMemoryIsSaidPlainly) {
   test::CommandResult r = run_hexbite({"--version"}, limit);
   EXPECT_EQ(r.exit_code, 0) << r.err;  // 124: timeout had to end it
   EXPECT_EQ(r.out.rfind("hexbite ", 0), 0u) << r.out;
+  // A value OpenBLAS does not take as a count (helper AA) is no choice of one.
+  for (const char* value : {"", "0", "abc"}) {
+    std::vector<std::string> with_value = {"env", std::string("OPENBLAS_NUM_THREADS=") + value};
+    with_value.insert(with_value.end(), limit.begin(), limit.end());
+    EXPECT_EQ(run_hexbite({"--version"}, with_value).exit_code, 0)
+        << "OPENBLAS_NUM_THREADS='" << value << "'";
+  }
 
   const std::string dir = temp_dir();
   ASSERT_EQ(run_hexbite({"-q", "generate", "mandible", "-o", dir + "/m.stl"}).exit_code, 0);
