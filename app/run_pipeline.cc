@@ -300,13 +300,51 @@ long long count_dofs(const HexMesh& mesh, int degree) {
 // measured on a Q1 block of 204,828 DoFs).
 constexpr double kBytesPerDof = 5e3;
 
+// Address space a direct solve needs besides its matrix and factors: OpenBLAS's work buffer of 128 MB per
+// thread, which this OpenBLAS, when it cannot allocate it, retries forever (measured on the shipped
+// scenario's level 0 under ulimit -v: the process maps about 1.0 GB before the solve; at 1.1 GB it hung
+// inside MUMPS, at 1.2 GB it solved, at 1.0 GB MUMPS itself failed).
+constexpr double kDirectSolverHeadroom = 0.5e9;
+
+// Why the memory left (machine_memory(): under ulimit -v the address space left) cannot hold a direct solve
+// of `dofs` unknowns, or "" when it can. Collective under mpirun: every rank takes the same decision, from
+// the rank with the least room (one rank solving with MUMPS and another with CG ended in std::terminate,
+// helper AA).
+std::string direct_solver_room_problem(double dofs) {
+  const MemoryLimit memory = machine_memory();
+  const double needed = kDirectSolverHeadroom + kBytesPerDof * dofs / MpiSession::size();
+  const double own = memory.bytes > 0 ? memory.bytes : std::numeric_limits<double>::infinity();
+  const double least = MpiSession::min_over_ranks(own);
+  if (least >= needed) return "";
+  char text[512];
+  std::snprintf(text, sizeof text, "the direct solver needs about %.2g GB, more than the %.2g GB of %s",
+                needed / 1e9, least / 1e9,
+                least < own ? "another rank's memory, the least of the ranks'" : memory.source.c_str());
+  return text;
+}
+
+// A scenario that asks for the direct solver where it has no room: refused at its linear_solver line (a
+// study's own line when the study set it).
+[[noreturn]] void refuse_direct_solver(const Scenario& s, int level, double dofs,
+                                       const std::string& problem) {
+  const SourceLocation& at = s.solver.linear_solver_at.line ? s.solver.linear_solver_at : s.solver.where;
+  char where[160];
+  std::snprintf(where, sizeof where,
+                ": solver.linear_solver direct, level %d (%.0f degrees of freedom): ", level, dofs);
+  throw InputError((at.line ? at.str() : s.path) + where + problem +
+                   "; set solver.linear_solver: cg_amg (or auto), which needs far less, or raise the limit");
+}
+
 // Each validation level multiplies the problem by 8 (a Q2 problem of the shipped 4,000 hexes has 7 million
 // DoFs at level 2): a last level whose solve needs more than this machine's memory (or the container's
 // cgroup limit, when lower), even shared by all ranks, is refused before the refinement, instead of ending
 // minutes later in bad_alloc or the kernel's out-of-memory kill.
 void require_levels_fit_memory(const Scenario& s, const HexMesh& coarse, int levels, bool in_study) {
-  if (levels == 0) return;
   const double dofs = static_cast<double>(count_dofs(coarse, s.solver.degree)) * std::pow(8.0, levels);
+  if (s.solver.linear_solver == LinearSolverChoice::kDirect)
+    if (const std::string problem = direct_solver_room_problem(dofs); !problem.empty())
+      refuse_direct_solver(s, levels, dofs, problem);  // before any solve (a study: before any variant's)
+  if (levels == 0) return;
   const double needed = kBytesPerDof * dofs / MpiSession::size();
   const MemoryLimit memory = machine_memory();
   if (memory.bytes <= 0 || needed <= memory.bytes) return;
@@ -796,12 +834,6 @@ void check_held_without_released(const Scenario& s, const LevelResult& r, const 
   }
 }
 
-// Address space a direct solve needs besides its matrix and factors: OpenBLAS's work buffer of 128 MB per
-// thread, which this OpenBLAS, when it cannot allocate it, retries forever (measured on the shipped
-// scenario's level 0 under ulimit -v: the process maps about 1.0 GB before the solve; at 1.1 GB it hung
-// inside MUMPS, at 1.2 GB it solved, at 1.0 GB MUMPS itself failed).
-constexpr double kDirectSolverHeadroom = 0.5e9;
-
 // solve_elasticity(p) on `dofs` degrees of freedom. The direct solver needs address space that an
 // address-space limit (ulimit -v) may not leave: when solver.linear_solver is auto, it chose the direct
 // solver for a small problem, and CG with AMG, which gives the same answer with far less memory, solves
@@ -812,17 +844,10 @@ ElasticitySolution solve_or_fall_back(const Scenario& s, ElasticityProblem& p, i
   const std::string at_level =
       "level " + std::to_string(level) + " (" + std::to_string(dofs) + " degrees of freedom): ";
   if (p.solver.linear_solver == LinearSolver::kDirect) {
-    const MemoryLimit memory = machine_memory();
-    const double needed = kDirectSolverHeadroom + kBytesPerDof * static_cast<double>(dofs);
-    if (memory.bytes > 0 && memory.bytes < needed) {
-      char text[512];
-      std::snprintf(text, sizeof text, "the direct solver needs about %.2g GB, more than the %.2g GB of %s",
-                    needed / 1e9, memory.bytes / 1e9, memory.source.c_str());
-      if (!automatic)
-        throw InputError((s.solver.where.line ? s.solver.where.str() : s.path) + ": " + at_level + text +
-                         "; set solver.linear_solver: cg_amg (or auto), which needs far less, or raise the "
-                         "limit");
-      warn(at_level + text + "; solving with CG and AMG instead (solver.linear_solver: auto)");
+    // Checked again here: the run maps more by now than when require_levels_fit_memory() looked.
+    if (const std::string problem = direct_solver_room_problem(static_cast<double>(dofs)); !problem.empty()) {
+      if (!automatic) refuse_direct_solver(s, level, static_cast<double>(dofs), problem);
+      warn(at_level + problem + "; solving with CG and AMG instead (solver.linear_solver: auto)");
       p.solver.linear_solver = LinearSolver::kCgAmg;
     }
   }
@@ -888,9 +913,9 @@ void solve_level(const Scenario& s, LevelResult& r) {
     try {
       r.solution = solve_or_fall_back(s, p, r.level, dofs);
     } catch (const DirectSolverError& e) {
-      throw RunError((s.solver.where.line ? s.solver.where.str() : s.path) + ": level " +
-                     std::to_string(r.level) + " (" + std::to_string(dofs) +
-                     " degrees of freedom): " + e.what() +
+      const SourceLocation& at = s.solver.linear_solver_at.line ? s.solver.linear_solver_at : s.solver.where;
+      throw RunError((at.line ? at.str() : s.path) + ": level " + std::to_string(r.level) + " (" +
+                     std::to_string(dofs) + " degrees of freedom): " + e.what() +
                      "; give the process more memory, or set solver.linear_solver: cg_amg (or auto), which "
                      "needs far less");
     } catch (const RunError& e) {

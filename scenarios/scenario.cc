@@ -639,10 +639,12 @@ SolverSpec parse_solver(const Value& v) {
     if (n != 1 && n != 2) fail(x->at, "solver.degree is " + std::to_string(n) + "; use 1 (Q1) or 2 (Q2)");
     s.degree = static_cast<int>(n);
   }
-  if (auto x = map.find("linear_solver"))
+  if (auto x = map.find("linear_solver")) {
+    s.linear_solver_at = x->at;
     s.linear_solver = to_choice<LinearSolverChoice>(*x, {{"auto", LinearSolverChoice::kAuto},
                                                          {"cg_amg", LinearSolverChoice::kCgAmg},
                                                          {"direct", LinearSolverChoice::kDirect}});
+  }
   if (auto x = map.find("tolerance")) {
     s.tolerance_at = x->at;
     s.tolerance = to_number(*x);

@@ -170,6 +170,8 @@ struct SolverSpec {
   // Where tolerance and max_iterations were written (empty: defaults). A study that sets one is named at
   // its own line; a failed solve named the base's `solver` line.
   SourceLocation tolerance_at, max_iterations_at;
+  // Where linear_solver was written (empty: the default), for a direct solver that the memory cannot hold.
+  SourceLocation linear_solver_at;
 };
 
 struct Outputs {

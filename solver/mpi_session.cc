@@ -76,4 +76,9 @@ int MpiSession::size() {
   return static_cast<int>(dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD));
 }
 
+double MpiSession::min_over_ranks(double value) {
+  if (size() == 1) return value;
+  return dealii::Utilities::MPI::min(value, MPI_COMM_WORLD);
+}
+
 }  // namespace hexbite

@@ -20,6 +20,9 @@ class MpiSession {
   // This process's rank in MPI_COMM_WORLD and the number of ranks (0 and 1 when no session was started).
   static int rank();
   static int size();
+  // The smallest of `value` over all ranks (collective: every rank must call it); `value` itself when
+  // there is one rank. For decisions that every rank must take alike.
+  static double min_over_ranks(double value);
 };
 
 }  // namespace hexbite

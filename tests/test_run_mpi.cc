@@ -97,6 +97,27 @@ TEST(RunMpi, AnErrorOfOneRankEndsTheJob) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// linear_solver auto chose the direct solver or CG on each rank from its own memory: with rank 1 under an
+// address-space limit (ulimit -v) that leaves no room for MUMPS, rank 0 factorized and rank 1 iterated, and
+// the job ended in std::terminate inside Epetra (helper AA). Every rank now takes the least room's choice.
+TEST(RunMpi, RanksWithDifferentMemoryTakeTheSameSolver) {
+  std::vector<std::string> launcher = kTwoRanks;
+  launcher.insert(launcher.begin(), {"timeout", "300"});
+  launcher.insert(launcher.end(),
+                  {"bash", "-c",
+                   "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then ulimit -v 1200000; fi; exec \"$@\"", "bash"});
+  const std::string out = test::temp_dir() + "/out";
+  const test::CommandResult r =
+      test::run_hexbite({"run", std::string(HEXBITE_SOURCE_DIR) + "/scenarios/lateral_bite_hard_nut.yaml",
+                         "-o", out, "--levels", "0"},
+                        launcher);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(count(r.err, "the direct solver needs about"), 1u) << r.err;
+  EXPECT_NE(r.err.find("another rank's memory, the least of the ranks'"), std::string::npos) << r.err;
+  const json run = json::parse(test::read_file(out + "/results.json"));
+  EXPECT_GT(run["solver"]["iterations"].get<int>(), 0);  // CG on both ranks
+}
+
 // Rank 1's piece cannot be moved into place (a folder of its name is in the way): the run used to leave
 // rank 0's new mesh.vtu and solution.pvtu beside the earlier results.json, print the error with rank 1's
 // prefix and abort the job. Now nothing moves, and rank 0 reports.

@@ -866,6 +866,24 @@ TEST(Study, SigtermOrSighupWhileSolvingRemovesTheStageAndTheFolderItCreated) {
   }
 }
 
+// A variant that asked for the direct solver where the address space left (ulimit -v) cannot hold it was
+// refused only at its solve, after the variants before it had solved, and named at the base's `solver` line
+// (helper AA). It is refused with the memory check of the validation levels, at the study's line.
+TEST(Study, ADirectSolverTheMemoryCannotHoldIsRefusedBeforeAnySolveAtTheStudysLine) {
+  std::string study = kStudy;
+  study.replace(study.find("      materials.default.E_MPa: 5500"), 35, "      solver: {linear_solver: direct}");
+  const std::string dir = study_folder(study);
+  const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out"},
+                                                  {"prlimit", "--as=1200000000", "--"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(dir + "/study.yaml:7:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("variant 'soft'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("solver.linear_solver direct, level 0 ("), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("\nvariant 1 / 3: reference"), std::string::npos) << "solved before the refusal:\n"
+                                                                         << r.out;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
 // A missing, empty or non-text base was told "write a word such as left_condyle", the hint for point names.
 TEST(Study, ABaseThatIsNoPathAsksForTheBaseScenariosFile) {
   for (const char* base : {"base: \"\"", "base:", "base: [a]"}) {
