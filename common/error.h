@@ -7,15 +7,24 @@
 
 namespace hexbite {
 
-// The message with control bytes other than line breaks and tabs written as \xNN. Messages quote lines and
+// The message with control bytes other than line breaks and tabs written as \xNN, and the C1 control
+// characters of UTF-8 (U+0080-U+009F) as \u00NN. Messages quote lines and
 // names from the user's files, and a NUL byte in one (binary bytes in a text file) cut the message there:
 // what() is a C string, so the file's line and the advice after it were lost.
 inline std::string printable_message(const std::string& message) {
   std::string out;
   out.reserve(message.size());
-  for (const char c : message) {
+  for (std::size_t i = 0; i < message.size(); ++i) {
+    const char c = message[i];
     const auto byte = static_cast<unsigned char>(c);
-    if (byte >= 0x20 && byte != 0x7f) {
+    const auto next = i + 1 < message.size() ? static_cast<unsigned char>(message[i + 1]) : 0u;
+    if (byte == 0xC2 && next >= 0x80 && next <= 0x9F) {
+      // A C1 control character in UTF-8 (U+009B acts on a terminal as ESC [ does).
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", next);
+      out += escaped;
+      ++i;
+    } else if (byte >= 0x20 && byte != 0x7f) {
       out += c;
     } else if (c == '\n' || c == '\t') {
       out += c;

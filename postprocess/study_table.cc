@@ -142,10 +142,10 @@ std::string study_changes(const json& set, bool abbreviate) {
     std::string text = value.is_string() ? value.get<std::string>() : yaml_flow(value);
     if (abbreviate && text.size() > 40 && value.is_structured()) text = value.is_object() ? "{...}" : "[...]";
     // On one line (studies.md): a YAML block text (`description: |`) kept its line breaks in the CSV cell. A
-    // tab and a Unicode line or paragraph separator are spaces too.
-    for (const char* separator : {"\u2028", "\u2029"})
+    // tab, a Unicode line or paragraph separator and U+0085 (NEXT LINE) are spaces too.
+    for (const std::string separator : {"\u2028", "\u2029", "\u0085"})
       for (std::size_t at = text.find(separator); at != std::string::npos; at = text.find(separator, at))
-        text.replace(at, 3, " ");
+        text.replace(at, separator.size(), " ");
     std::string line;
     for (char c : text) {
       if (c == '\n' || c == '\r' || c == '\t') c = ' ';

@@ -565,6 +565,9 @@ TEST_F(Report, ValuesNoRunWritesAndABlankTitleAreRefused) {
        "b",
        "--title: the title holds a control character (0x01); it is one line of printable text: remove it"},
       {"two\nlines", "--title: the title holds a control character (0x0A, a line break)"},
+      // The C1 controls and the Unicode separators passed (helper AA).
+      {"T\u009b2J", "--title: the title holds a control character (U+009B)"},
+      {"two\u2028lines", "--title: the title holds a Unicode line separator (U+2028)"},
   };
   for (const auto& [title, message] : titles) {
     const test::CommandResult r =

@@ -401,6 +401,13 @@ TEST(ScenarioErrors, NamesWithControlCharactersAreRefusedAtTheirLine) {
                   "supports[0].name holds a control character (0x01)");
   EXPECT_ERROR_AT(error_of(kValid + "probes:\n  - {name: \"chin\\r\", at: incisal_point}\n"), 12,
                   "probes[0].name holds a control character (0x0D)");
+  // The C1 controls and the Unicode separators passed (helper AA): U+0085 is NEXT LINE, YAML's "\N".
+  EXPECT_ERROR_AT(error_of(replace(kValid, "name: t", "name: \"ab\\u0085cd\"")), 1,
+                  "name holds a control character (U+0085, a line break)");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "{name: nut,", "{name: \"n\\u009but\",")), 8,
+                  "supports[0].name holds a control character (U+009B)");
+  EXPECT_ERROR_AT(error_of(replace(kValid, "{name: nut,", "{name: \"n\\u2028ut\",")), 8,
+                  "supports[0].name holds a Unicode line separator (U+2028)");
 }
 
 // mesh.fit_volume (the boundary nodes moved off the surface until the volume matches) is read for both

@@ -499,12 +499,14 @@ TEST(StudyTable, AControlCharacterInAChangeIsWrittenVisibly) {
   StudyTable table;
   StudyRow row;
   row.name = "v";
-  const char description[] = "a\tb\x1b[2Jc\0d\x7f e\u2028f\u2029";  // with a NUL
+  // With a NUL, and the C1 controls U+0085 (NEXT LINE, a line break) and U+009B (which a terminal takes as
+  // ESC [), which were written raw (helper AA).
+  const char description[] = "a\tb\x1b[2Jc\0d\x7f e\u2028f\u2029g\u0085h\u009b2J";
   row.set = {{"description", std::string(description, sizeof description - 1)}};
   table.rows.push_back(row);
   const nlohmann::ordered_json study = study_json(table);
   EXPECT_EQ(study["variants"][0]["set"], row.set);
-  const std::string line = "description: a b\\x1b[2Jc\\x00d\\x7f e f";
+  const std::string line = "description: a b\\x1b[2Jc\\x00d\\x7f e f g h\\u009b2J";
   EXPECT_EQ(study_changes(row.set, false), line);
   const std::string csv = study_csv(study);
   const std::string md = study_markdown(study);
@@ -514,6 +516,7 @@ TEST(StudyTable, AControlCharacterInAChangeIsWrittenVisibly) {
     EXPECT_TRUE(std::none_of(text.begin(), text.end(), [](char c) {
       return c != '\n' && (static_cast<unsigned char>(c) < 0x20 || c == 0x7f);
     })) << text;
+  for (const std::string& text : {csv, md}) EXPECT_EQ(text.find("\xc2"), std::string::npos) << text;
 }
 
 // A backtick in a set value ended study.md's code span: the span is fenced by more backticks than it holds.
@@ -871,7 +874,8 @@ TEST(Study, SigtermOrSighupWhileSolvingRemovesTheStageAndTheFolderItCreated) {
 // (helper AA). It is refused with the memory check of the validation levels, at the study's line.
 TEST(Study, ADirectSolverTheMemoryCannotHoldIsRefusedBeforeAnySolveAtTheStudysLine) {
   std::string study = kStudy;
-  study.replace(study.find("      materials.default.E_MPa: 5500"), 35, "      solver: {linear_solver: direct}");
+  study.replace(study.find("      materials.default.E_MPa: 5500"), 35,
+                "      solver: {linear_solver: direct}");
   const std::string dir = study_folder(study);
   const test::CommandResult r = test::run_hexbite({"study", dir + "/study.yaml", "-o", dir + "/out"},
                                                   {"prlimit", "--as=1200000000", "--"});
