@@ -31,16 +31,19 @@
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <GL/glx.h>
+#include <GL/glxext.h>
 #include <X11/Xlib.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -50,21 +53,109 @@
 
 namespace hexbite {
 
-std::string display_problem() {
+namespace {
+
+// Set by x_error_caught while it is the X error handler: Xlib's own handler ends the process.
+bool x_error_seen = false;
+int x_error_caught(Display*, XErrorEvent*) {
+  x_error_seen = true;
+  return 0;
+}
+
+// Why no OpenGL context that VTK can draw with (3.2 or later) can be made on `config`, or empty. The GLX
+// checks below passed on displays where VTK then aborted ("Cannot create GLX context. Aborting.", exit 134)
+// or crashed: an OpenGL driver that does not load (as under `ulimit -v`), indirect GLX (LIBGL_ALWAYS_INDIRECT
+// =1; X servers refuse it with an X error, whose default handler ends the process), an OpenGL older than
+// VTK needs. So a context is made as VTK 9.1 makes it, made current on a tiny unmapped window, and freed,
+// with X errors caught meanwhile.
+std::string context_problem(Display* x, GLXFBConfig config) {
+  XErrorHandler previous = XSetErrorHandler(x_error_caught);
+  x_error_seen = false;
+  const auto failed = [x] {  // an X error since the last check
+    XSync(x, False);
+    return std::exchange(x_error_seen, false);
+  };
+  XVisualInfo* visual = glXGetVisualFromFBConfig(x, config);
+  const Window root = RootWindow(x, DefaultScreen(x));
+  XSetWindowAttributes window_attributes{};  // with a border pixel: the visual need not be the root's
+  window_attributes.colormap = visual == nullptr ? None : XCreateColormap(x, root, visual->visual, AllocNone);
+  const Window window = visual == nullptr
+                            ? None
+                            : XCreateWindow(x, root, 0, 0, 1, 1, 0, visual->depth, InputOutput,
+                                            visual->visual, CWColormap | CWBorderPixel, &window_attributes);
+  GLXContext context = nullptr;
+  const auto keep_if_no_error = [&] {  // a context whose creation the server refused is no context
+    if (failed() && context != nullptr) {
+      glXDestroyContext(x, context);
+      context = nullptr;
+    }
+  };
+  std::string problem;
+  if (window == None || failed()) {
+    problem = "no window for OpenGL could be made";
+  } else {
+    // As VTK 9.1: a 3.2 context through GLX_ARB_create_context, else one of any version.
+    const auto create_with_attributes = reinterpret_cast<PFNGLXCREATECONTEXTATTRIBSARBPROC>(
+        glXGetProcAddressARB(reinterpret_cast<const GLubyte*>("glXCreateContextAttribsARB")));
+    const int version_3_2[] = {GLX_CONTEXT_MAJOR_VERSION_ARB, 3, GLX_CONTEXT_MINOR_VERSION_ARB, 2, None};
+    if (create_with_attributes != nullptr) {
+      context = create_with_attributes(x, config, nullptr, True, version_3_2);
+      keep_if_no_error();
+    }
+    if (context == nullptr) {
+      context = glXCreateNewContext(x, config, GLX_RGBA_TYPE, nullptr, True);
+      keep_if_no_error();
+    }
+    if (context == nullptr) {
+      problem =
+          "no OpenGL context could be made (the X server refused it, as with LIBGL_ALWAYS_INDIRECT=1, "
+          "or the OpenGL driver did not load: not installed, or too little memory under ulimit -v?)";
+    } else if (!glXMakeContextCurrent(x, window, window, context) || failed()) {
+      problem = "its OpenGL context cannot be used";
+    } else {
+      const auto get_string = reinterpret_cast<const GLubyte* (*)(GLenum)>(
+          glXGetProcAddressARB(reinterpret_cast<const GLubyte*>("glGetString")));
+      const char* version =
+          get_string == nullptr ? nullptr : reinterpret_cast<const char*>(get_string(GL_VERSION));
+      int major = 0, minor = 0;
+      if (version == nullptr || std::sscanf(version, "%d.%d", &major, &minor) != 2 ||
+          std::make_pair(major, minor) < std::make_pair(3, 2))
+        problem = std::string("its OpenGL is version ") + (version == nullptr ? "unknown" : version) +
+                  ", and VTK needs 3.2 or later";
+      glXMakeContextCurrent(x, None, None, nullptr);
+    }
+  }
+  if (context != nullptr) glXDestroyContext(x, context);
+  if (window != None) XDestroyWindow(x, window);
+  if (window_attributes.colormap != None) XFreeColormap(x, window_attributes.colormap);
+  if (visual != nullptr) XFree(visual);
+  failed();  // the errors of these requests are still this handler's
+  XSetErrorHandler(previous);
+  return problem;
+}
+
+// The process's connection to the X server, or nullptr when it does not answer. It stays open for the
+// process's life: an X server without other clients (xvfb-run's) resets when the last one leaves, and VTK's
+// own connection, made right after the check's, was refused now and then during that reset. VTK draws
+// through it as well: with a connection of its own the OpenGL driver was set up twice, for the check's
+// context and for VTK's, and under a `ulimit -v` that the check had passed VTK then crashed for want of room.
+Display* x_connection() {
+  static Display* const connection = XOpenDisplay(nullptr);
+  return connection;
+}
+
+std::string check_display() {
   const char* display = std::getenv("DISPLAY");
   if (display == nullptr || *display == '\0') return "DISPLAY is not set";
-  // A DISPLAY left over from a closed ssh session or an ended Xvfb: VTK would abort on it. The connection
-  // stays open for the process's life: an X server without other clients (xvfb-run's) resets when the last
-  // one leaves, and VTK's own connection, made right after, was refused now and then during that reset.
-  static Display* const probe = XOpenDisplay(nullptr);
+  // A DISPLAY left over from a closed ssh session or an ended Xvfb: VTK would abort on it.
+  Display* const probe = x_connection();
   if (probe == nullptr) return std::string("the X display '") + display + "' does not answer";
   // A display that answers but cannot give VTK an OpenGL context (an X server without the GLX extension,
   // as many ssh -X and VNC servers are, or an 8-bit screen without a colour visual with a depth buffer):
   // VTK aborted on it ("Could not find a decent config", exit 134), and `report` left its temporary folder.
   int error_base = 0, event_base = 0;
   if (!glXQueryExtension(probe, &error_base, &event_base))
-    return std::string("the X display '") + display +
-           "' has no OpenGL: its X server lacks the GLX extension";
+    return std::string("the X display '") + display + "' has no OpenGL: its X server lacks the GLX extension";
   const int attributes[] = {GLX_DRAWABLE_TYPE,
                             GLX_WINDOW_BIT,
                             GLX_RENDER_TYPE,
@@ -80,11 +171,22 @@ std::string display_problem() {
                             None};
   int configs = 0;
   GLXFBConfig* found = glXChooseFBConfig(probe, DefaultScreen(probe), attributes, &configs);
+  const std::string problem = configs == 0 ? std::string() : context_problem(probe, found[0]);
   if (found != nullptr) XFree(found);
   if (configs == 0)
     return std::string("the X display '") + display +
            "' has no OpenGL: no visual with colour and depth (a screen of 8 bits per pixel?)";
+  if (!problem.empty())
+    return std::string("the X display '") + display + "' has no usable OpenGL: " + problem;
   return {};
+}
+
+}  // namespace
+
+// Checked once: a report asks before each picture, and making an OpenGL context takes a while.
+std::string display_problem() {
+  static const std::string problem = check_display();
+  return problem;
 }
 
 namespace {
@@ -215,6 +317,7 @@ void render_actor_png(vtkActor* actor, vtkActor2D* legend, const std::string& pn
   }
 
   vtkNew<vtkRenderWindow> window;
+  window->SetDisplayId(x_connection());
   window->SetOffScreenRendering(1);
   window->AddRenderer(renderer);
   window->SetSize(options.width, options.height);

@@ -18,8 +18,9 @@ struct RenderOptions {
 };
 
 // Why VTK cannot open a window here ("DISPLAY is not set", "the X display ':77' does not answer", "the X
-// display ':77' has no OpenGL ..."), or empty when it can. Rendering without a display aborts inside VTK
-// (exit 134), so callers check this first and tell the user to run under `xvfb-run -a`.
+// display ':77' has no OpenGL ..." or "... has no usable OpenGL: <what failed>" when no OpenGL 3.2 context
+// can be made and used on it), or empty when it can; checked once per process. Rendering without a display
+// aborts inside VTK (exit 134), so callers check this first and tell the user to run under `xvfb-run -a`.
 std::string display_problem();
 
 // Renders the triangle surface and writes a PNG atomically. Throws RunError when no display.

@@ -279,23 +279,33 @@ TEST_F(Report, EmbedsThePicturesAsPngAndLeavesNoTemporaryFiles) {
 }
 
 // A display that answers but has no OpenGL (an X server without GLX, as many ssh -X and VNC servers are):
-// VTK aborted (exit 134) and left the pictures' temporary folder behind.
+// VTK aborted (exit 134) and left the pictures' temporary folder behind. So did one with GLX where no context
+// can be made (indirect GLX, LIBGL_ALWAYS_INDIRECT=1, which X servers refuse).
 TEST_F(Report, ADisplayWithoutOpenGlIsRefusedAndLeavesNothing) {
-  const test::VirtualDisplay x({"-extension", "GLX"});
-  if (x.display().empty()) GTEST_SKIP() << "no X server for this test: " << x.problem();
-  const std::string dir = temp_dir(), tmp = dir + "/tmp";
-  fs::create_directories(tmp);
-  const test::CommandResult r = run_hexbite({"-q", "report", *run_dir_, "-o", dir + "/r.html"},
-                                            {"env", "DISPLAY=" + x.display(), "TMPDIR=" + tmp});
-  EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("cannot draw the report's pictures: no X display (the X display '" + x.display() +
-                       "' has no OpenGL: its X server lacks the GLX extension"),
-            std::string::npos)
-      << r.err;
-  EXPECT_NE(r.err.find("run the command under `xvfb-run -a`, or add --no-pictures"), std::string::npos)
-      << r.err;
-  EXPECT_FALSE(fs::exists(dir + "/r.html"));
-  EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
+  struct Case {
+    std::vector<std::string> options;
+    std::string environment, fragment;
+  };
+  for (const Case& c :
+       {Case{{"-extension", "GLX"}, "", "has no OpenGL: its X server lacks the GLX extension"},
+        Case{{}, "LIBGL_ALWAYS_INDIRECT=1", "has no usable OpenGL: no OpenGL context"}}) {
+    const test::VirtualDisplay x(c.options);
+    if (x.display().empty()) GTEST_SKIP() << "no X server for this test: " << x.problem();
+    const std::string dir = temp_dir(), tmp = dir + "/tmp";
+    fs::create_directories(tmp);
+    std::vector<std::string> launcher = {"env", "DISPLAY=" + x.display(), "TMPDIR=" + tmp};
+    if (!c.environment.empty()) launcher.push_back(c.environment);
+    const test::CommandResult r = run_hexbite({"-q", "report", *run_dir_, "-o", dir + "/r.html"}, launcher);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find("cannot draw the report's pictures: no X display (the X display '" + x.display() +
+                         "' " + c.fragment),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("run the command under `xvfb-run -a`, or add --no-pictures"), std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/r.html"));
+    EXPECT_TRUE(fs::is_empty(tmp)) << "the pictures' temporary folder was left behind";
+  }
 }
 
 // A TMPDIR that filled up while the pictures were drawn there was blamed on the report's folder ("make room
