@@ -335,8 +335,7 @@ int main(int argc, char** argv) {
     return report(
         "hexbite: failed: out of memory: the machine's memory, a container's or batch job's memory limit, "
         "or the address-space limit (ulimit -v) is too small for this work; give the process more, or ask "
-        "for "
-        "less (fewer hexes, fewer validation levels)\n",
+        "for less (fewer hexes, fewer validation levels)\n",
         hexbite::kExitRunFailed, errors);
   } catch (const std::exception& e) {
     return report(std::string("hexbite: failed: ") + e.what() + '\n', hexbite::kExitRunFailed, errors);

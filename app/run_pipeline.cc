@@ -323,15 +323,20 @@ std::string direct_solver_room_problem(double dofs) {
   return text;
 }
 
-// A scenario that asks for the direct solver where it has no room: refused at its linear_solver line (a
-// study's own line when the study set it).
+// Where the scenario chose its linear solver, for a message about the direct solver: the linear_solver
+// line (a study's own line when the study set it), else the `solver` mapping, else the file.
+std::string linear_solver_place(const Scenario& s) {
+  const SourceLocation& at = s.solver.linear_solver_at.line ? s.solver.linear_solver_at : s.solver.where;
+  return at.line ? at.str() : s.path;
+}
+
+// A scenario that asks for the direct solver where it has no room: refused at linear_solver_place().
 [[noreturn]] void refuse_direct_solver(const Scenario& s, int level, double dofs,
                                        const std::string& problem) {
-  const SourceLocation& at = s.solver.linear_solver_at.line ? s.solver.linear_solver_at : s.solver.where;
   char where[160];
   std::snprintf(where, sizeof where,
                 ": solver.linear_solver direct, level %d (%.0f degrees of freedom): ", level, dofs);
-  throw InputError((at.line ? at.str() : s.path) + where + problem +
+  throw InputError(linear_solver_place(s) + where + problem +
                    "; set solver.linear_solver: cg_amg (or auto), which needs far less, or raise the limit");
 }
 
@@ -841,22 +846,23 @@ void check_held_without_released(const Scenario& s, const LevelResult& r, const 
 // run's CG iterations then show it. A scenario that asked for the direct solver is refused before the solve.
 ElasticitySolution solve_or_fall_back(const Scenario& s, ElasticityProblem& p, int level, long long dofs) {
   const bool automatic = s.solver.linear_solver == LinearSolverChoice::kAuto;
-  const std::string at_level =
-      "level " + std::to_string(level) + " (" + std::to_string(dofs) + " degrees of freedom): ";
+  const auto fall_back = [&](const std::string& why) {
+    warn("level " + std::to_string(level) + " (" + std::to_string(dofs) + " degrees of freedom): " + why +
+         "; solving with CG and AMG instead (solver.linear_solver: auto)");
+    p.solver.linear_solver = LinearSolver::kCgAmg;
+  };
   if (p.solver.linear_solver == LinearSolver::kDirect) {
     // Checked again here: the run maps more by now than when require_levels_fit_memory() looked.
     if (const std::string problem = direct_solver_room_problem(static_cast<double>(dofs)); !problem.empty()) {
       if (!automatic) refuse_direct_solver(s, level, static_cast<double>(dofs), problem);
-      warn(at_level + problem + "; solving with CG and AMG instead (solver.linear_solver: auto)");
-      p.solver.linear_solver = LinearSolver::kCgAmg;
+      fall_back(problem);
     }
   }
   try {
     return solve_elasticity(p);
   } catch (const DirectSolverError& e) {
     if (!automatic) throw;
-    warn(at_level + e.what() + "; solving with CG and AMG instead (solver.linear_solver: auto)");
-    p.solver.linear_solver = LinearSolver::kCgAmg;
+    fall_back(e.what());
     return solve_elasticity(p);
   }
 }
@@ -913,8 +919,7 @@ void solve_level(const Scenario& s, LevelResult& r) {
     try {
       r.solution = solve_or_fall_back(s, p, r.level, dofs);
     } catch (const DirectSolverError& e) {
-      const SourceLocation& at = s.solver.linear_solver_at.line ? s.solver.linear_solver_at : s.solver.where;
-      throw RunError((at.line ? at.str() : s.path) + ": level " + std::to_string(r.level) + " (" +
+      throw RunError(linear_solver_place(s) + ": level " + std::to_string(r.level) + " (" +
                      std::to_string(dofs) + " degrees of freedom): " + e.what() +
                      "; give the process more memory, or set solver.linear_solver: cg_amg (or auto), which "
                      "needs far less");

@@ -4,6 +4,8 @@
 
 #include <cstdio>
 
+#include "common/error.h"
+
 namespace hexbite {
 
 namespace {
@@ -21,19 +23,14 @@ std::string control_character_problem(const std::string& text) {
     const char c = text[i];
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
       return "holds a control character (" + byte_code(c) + (c == '\n' ? ", a line break" : "") + ")";
-    // The C1 controls U+0080-U+009F (UTF-8 C2 80-C2 9F: U+0085 is a line break, U+009B acts on a terminal
-    // as ESC [ does) and the Unicode line and paragraph separators passed (helper AA).
-    const std::string rest = text.substr(i, 3);
-    const auto second = rest.size() > 1 ? static_cast<unsigned char>(rest[1]) : 0u;
-    if (static_cast<unsigned char>(c) == 0xC2 && second >= 0x80 && second <= 0x9F) {
+    // The C1 controls and the Unicode line and paragraph separators passed (helper AA).
+    if (const unsigned c1 = c1_control_at(text, i)) {
       char code[8];
-      std::snprintf(code, sizeof code, "U+%04X", second);
-      return std::string("holds a control character (") + code + (second == 0x85 ? ", a line break" : "") +
-             ")";
+      std::snprintf(code, sizeof code, "U+%04X", c1);
+      return std::string("holds a control character (") + code + (c1 == 0x85 ? ", a line break" : "") + ")";
     }
-    if (rest == "\u2028" || rest == "\u2029")
-      return std::string("holds a Unicode ") + (rest == "\u2028" ? "line" : "paragraph") + " separator (U+" +
-             (rest == "\u2028" ? "2028" : "2029") + ")";
+    if (text.compare(i, 3, "\u2028") == 0) return "holds a Unicode line separator (U+2028)";
+    if (text.compare(i, 3, "\u2029") == 0) return "holds a Unicode paragraph separator (U+2029)";
   }
   return {};
 }
